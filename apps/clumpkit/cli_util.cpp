@@ -1,0 +1,47 @@
+#include "cli_util.hpp"
+
+#include <cstdlib>
+#include <iostream>
+
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+
+namespace clumpkit::cli {
+
+namespace fs = std::filesystem;
+
+fs::path data_dir() {
+  if (const char* env = std::getenv("CLUMPKIT_DATA"); env && *env) return env;
+  return CLUMPKIT_DATA_DIR;
+}
+
+fs::path resolve_shape(const std::string& arg) {
+  std::error_code ec;
+  if (fs::exists(arg, ec)) return arg;
+  for (const fs::path& cand : {data_dir() / "shapes" / (arg + ".toml"), data_dir() / "shapes" / arg})
+    if (fs::exists(cand, ec)) return cand;
+  throw InputError(arg, "", "no such shape file (nor a bundled shape in " +
+                                (data_dir() / "shapes").string() + ")");
+}
+
+void write_json(const nlohmann::json& j, const std::string& target) {
+  const std::string text = j.dump(2) + "\n";
+  if (target == "-") {
+    std::cout << text;
+  } else {
+    write_file_atomic(target, text);
+  }
+}
+
+}  // namespace clumpkit::cli
+
+namespace clumpkit::cli {
+
+std::vector<std::pair<int, Registration::Setup>>& registry() {
+  static std::vector<std::pair<int, Registration::Setup>> r;
+  return r;
+}
+
+Registration::Registration(int order, Setup setup) { registry().emplace_back(order, setup); }
+
+}  // namespace clumpkit::cli

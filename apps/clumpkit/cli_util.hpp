@@ -1,0 +1,38 @@
+#pragma once
+// Shared helpers of the CLI commands: data-folder lookup, output, number formatting.
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace clumpkit::cli {
+
+/// The bundled data folder (shapes/, meshes/): $CLUMPKIT_DATA, else the source tree's.
+std::filesystem::path data_dir();
+
+/// Resolves a shape argument: an existing path, or a bundled name ("pill_A" -> shapes/pill_A.toml).
+std::filesystem::path resolve_shape(const std::string& arg);
+
+/// Writes JSON to a file (atomically) or to stdout for "-".
+void write_json(const nlohmann::json& j, const std::string& target);
+
+/// A command registers itself on the app; the returned callback runs it and returns the exit code.
+using Runner = std::function<int()>;
+struct Command {
+  CLI::App* app;
+  Runner run;
+};
+
+}  // namespace clumpkit::cli
+
+namespace clumpkit::cli {
+
+/// Self-registration of commands: each cmd_<name>.cpp defines one static Registration.
+/// `order` sorts the subcommands in --help (pipeline order).
+struct Registration {
+  using Setup = Command (*)(CLI::App& parent);
+  Registration(int order, Setup setup);
+};
+std::vector<std::pair<int, Registration::Setup>>& registry();
+
+}  // namespace clumpkit::cli
