@@ -1,0 +1,40 @@
+#pragma once
+/// Reading closed triangle meshes (STL ascii/binary, OBJ, PLY, OFF) through assimp, welded,
+/// validated and oriented outward.
+#include <filesystem>
+
+#include "clumpkit/geometry/shape_spec.hpp"
+#include "clumpkit/mesh_io/mesh_report.hpp"
+#include "clumpkit/mesh_io/triangle_mesh.hpp"
+
+namespace clumpkit {
+
+struct MeshLoadOptions {
+  double scale = 1.0;  ///< factor from file units to metres (0.001 for a file in mm)
+  /// Vertices closer than this fraction of the bounding-box diagonal are merged.
+  double weld_tolerance = 1e-7;
+  /// Refuse (InputError) meshes whose enclosed volume would be meaningless.
+  bool require_closed = true;
+  bool check_self_intersections = true;
+};
+
+/// Loads, welds and validates a mesh; flips it to outward orientation if its signed volume is
+/// negative. Throws InputError naming the file (and the defect counts) for a missing, empty,
+/// unreadable or, with `require_closed`, an open/non-manifold/self-intersecting mesh.
+/// `report`, if given, receives the validation report of the returned mesh.
+TriangleMesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options,
+                       MeshReport* report = nullptr);
+
+/// Shorthand: load_mesh with the given scale and default options.
+TriangleMesh load_mesh(const std::filesystem::path& path, double scale = 1.0);
+
+/// The mesh of a ShapeSpec of kind mesh (its file, in its units). Throws InputError naming the
+/// shape file for a cylinder spec.
+TriangleMesh load_shape_mesh(const ShapeSpec& shape, MeshReport* report = nullptr);
+
+/// Merges vertices closer than `tolerance` (metres), drops triangles that collapse (repeated
+/// vertex) and unused vertices. Returns the number of vertices merged away; `collapsed`, if
+/// given, receives the number of triangles dropped.
+std::size_t weld_vertices(TriangleMesh& mesh, double tolerance, std::size_t* collapsed = nullptr);
+
+}  // namespace clumpkit

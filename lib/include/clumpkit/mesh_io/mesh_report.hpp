@@ -1,0 +1,47 @@
+#pragma once
+/// Validation of a triangle mesh as the boundary of a solid: the defects that would make its
+/// enclosed volume meaningless, counted.
+#include <cstddef>
+#include <string>
+
+#include "clumpkit/mesh_io/triangle_mesh.hpp"
+
+namespace clumpkit {
+
+struct MeshReport {
+  std::size_t vertices = 0;
+  std::size_t triangles = 0;
+  std::size_t welded_vertices = 0;     ///< merged by welding (loading only)
+  std::size_t collapsed_faces = 0;     ///< dropped because welding collapsed them (loading only)
+  std::size_t nonfinite_vertices = 0;  ///< NaN or infinite coordinates
+  std::size_t bad_indices = 0;         ///< triangles referring to missing or repeated vertices
+  std::size_t boundary_edges = 0;      ///< edges used by one triangle (open mesh)
+  std::size_t nonmanifold_edges = 0;   ///< edges used by more than two triangles
+  std::size_t inconsistent_edges = 0;  ///< edges whose two triangles disagree on orientation
+  std::size_t degenerate_faces = 0;    ///< (near-)zero area; harmless for volume, reported
+  /// Pairs of triangles that intersect other than at shared edges/vertices; -1 when not checked
+  /// (disabled, or the mesh is not a closed oriented manifold, which CGAL's check requires).
+  long long self_intersections = -1;
+  double signed_volume = 0.0;  ///< m^3, positive for outward orientation
+  double area = 0.0;           ///< m^2
+  bool flipped = false;        ///< orientation was reversed to make it outward (loading only)
+
+  /// True when the mesh bounds a solid whose volume and moments mean something.
+  bool closed_solid() const;
+  /// One line: the counts of every defect found, e.g. "12 boundary edges, 2 non-manifold edges".
+  std::string defects() const;
+};
+
+struct MeshValidateOptions {
+  bool check_self_intersections = true;
+  /// A face is degenerate when its area is below this times the squared bbox diagonal.
+  double degenerate_area = 1e-14;
+};
+
+/// Counts the defects of `mesh` without modifying it.
+MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidateOptions& options = {});
+
+/// Throws InputError(where, "", "<defects>: not a closed solid") unless report.closed_solid().
+void require_closed_solid(const MeshReport& report, const std::string& where);
+
+}  // namespace clumpkit

@@ -1,0 +1,159 @@
+#include "clumpkit/mesh_io/load_mesh.hpp"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+#include "clumpkit/core/error.hpp"
+
+namespace clumpkit {
+
+namespace fs = std::filesystem;
+
+std::size_t weld_vertices(TriangleMesh& mesh, double tol, std::size_t* collapsed) {
+  const std::size_t n = mesh.vertices.size();
+  std::vector<int> map(n, -1);
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(n);
+  // Hash grid of cell size tol: a vertex within tol of a kept one lies in one of the 27 cells
+  // around it. Greedy in file order, so the result is deterministic.
+  const double cell = tol > 0 ? tol : 1.0;
+  auto key = [](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return static_cast<std::uint64_t>(i * 73856093) ^ static_cast<std::uint64_t>(j * 19349663) ^
+           static_cast<std::uint64_t>(k * 83492791);
+  };
+  std::unordered_multimap<std::uint64_t, int> grid;
+  grid.reserve(n);
+  const double tol2 = tol * tol;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = mesh.vertices[i];
+    if (!p.allFinite()) {  // never merged: validation must still see and count it
+      map[i] = static_cast<int>(kept.size());
+      kept.push_back(p);
+      continue;
+    }
+    const Eigen::Vector3d q = p / cell;
+    const std::int64_t ci = static_cast<std::int64_t>(std::floor(q[0]));
+    const std::int64_t cj = static_cast<std::int64_t>(std::floor(q[1]));
+    const std::int64_t ck = static_cast<std::int64_t>(std::floor(q[2]));
+    int found = -1;
+    for (int di = -1; di <= 1 && found < 0; ++di)
+      for (int dj = -1; dj <= 1 && found < 0; ++dj)
+        for (int dk = -1; dk <= 1 && found < 0; ++dk) {
+          auto range = grid.equal_range(key(ci + di, cj + dj, ck + dk));
+          for (auto it = range.first; it != range.second; ++it)
+            if ((kept[it->second] - p).squaredNorm() <= tol2) {
+              found = it->second;
+              break;
+            }
+        }
+    if (found < 0) {
+      found = static_cast<int>(kept.size());
+      kept.push_back(p);
+      grid.emplace(key(ci, cj, ck), found);
+    }
+    map[i] = found;
+  }
+  std::size_t dropped = 0;
+  std::vector<Eigen::Vector3i> tris;
+  tris.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    bool in_range = true;
+    for (int k = 0; k < 3; ++k)
+      in_range = in_range && t[k] >= 0 && static_cast<std::size_t>(t[k]) < n;
+    if (!in_range) {  // left for validation to report
+      tris.push_back(t);
+      continue;
+    }
+    const Eigen::Vector3i w(map[t[0]], map[t[1]], map[t[2]]);
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) {
+      ++dropped;
+      continue;
+    }
+    tris.push_back(w);
+  }
+  if (collapsed) *collapsed = dropped;
+  const std::size_t merged = n - kept.size();
+  mesh.vertices = std::move(kept);
+  mesh.triangles = std::move(tris);
+  return merged;
+}
+
+TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshReport* report) {
+  const std::string where = path.string();
+  if (!(opt.scale > 0) || !std::isfinite(opt.scale))
+    throw InputError(where, "scale", "must be a positive finite factor to metres");
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(where, "", "no such mesh file");
+  if (fs::file_size(path, ec) == 0) throw InputError(where, "", "empty file (no triangles)");
+
+  Assimp::Importer importer;
+  // Only triangles and points/lines are of interest; normals, UVs and materials are not read.
+  const aiScene* scene =
+      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices);
+  if (!scene) {
+    throw InputError(
+        where, "",
+        std::string("cannot read as a mesh (STL, OBJ, PLY, OFF): ") + importer.GetErrorString());
+  }
+  TriangleMesh mesh;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    const int base = static_cast<int>(mesh.vertices.size());
+    for (unsigned i = 0; i < am->mNumVertices; ++i) {
+      const aiVector3D& v = am->mVertices[i];
+      mesh.vertices.emplace_back(opt.scale * static_cast<double>(v.x),
+                                 opt.scale * static_cast<double>(v.y),
+                                 opt.scale * static_cast<double>(v.z));
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines bound no volume
+      mesh.triangles.emplace_back(base + static_cast<int>(face.mIndices[0]),
+                                  base + static_cast<int>(face.mIndices[1]),
+                                  base + static_cast<int>(face.mIndices[2]));
+    }
+  }
+  if (mesh.triangles.empty()) throw InputError(where, "", "empty mesh (no triangles)");
+
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : mesh.vertices)
+    if (v.allFinite()) box.extend(v);
+  const double diag = box.isEmpty() ? 0.0 : box.diagonal().norm();
+  std::size_t collapsed = 0;
+  const std::size_t welded = weld_vertices(mesh, opt.weld_tolerance * diag, &collapsed);
+
+  MeshValidateOptions vopt;
+  vopt.check_self_intersections = opt.check_self_intersections;
+  MeshReport r = validate_mesh(mesh, vopt);
+  r.welded_vertices = welded;
+  r.collapsed_faces = collapsed;
+  if (opt.require_closed) require_closed_solid(r, where);
+  if (r.closed_solid() && r.signed_volume < 0) {
+    flip_orientation(mesh);
+    r.signed_volume = -r.signed_volume;
+    r.flipped = true;
+  }
+  if (report) *report = r;
+  return mesh;
+}
+
+TriangleMesh load_mesh(const fs::path& path, double scale) {
+  MeshLoadOptions opt;
+  opt.scale = scale;
+  return load_mesh(path, opt);
+}
+
+TriangleMesh load_shape_mesh(const ShapeSpec& shape, MeshReport* report) {
+  if (shape.kind != ShapeSpec::Kind::Mesh)
+    throw InputError(shape.path.string(), "shape.kind", "not a mesh shape");
+  MeshLoadOptions opt;
+  opt.scale = shape.mesh_scale;
+  return load_mesh(shape.mesh, opt, report);
+}
+
+}  // namespace clumpkit
