@@ -29,7 +29,7 @@ TEST(Units, RejectsWithFieldNamed) {
   };
   const Case cases[] = {
       {"6.0", Dimension::Length, "has no unit"},
-      {"6.0 kg", Dimension::Length, "is not a length"},
+      {"6.0 kg", Dimension::Length, "is not a unit of length"},
       {"6.0 furlong", Dimension::Length, "unknown unit"},
       {"abc mm", Dimension::Length, "not a number"},
       {"", Dimension::Length, "empty"},

@@ -124,8 +124,8 @@ double unit_factor(std::string_view unit, Dimension d, const std::string& where,
   std::string expected = std::string("expected a ") + dimension_name(d) + " in " + si_unit(d);
   if (known)
     throw InputError(where, field,
-                     "unit '" + std::string(unit) + "' is not a " + dimension_name(d) + " (" +
-                         expected + " or a compatible unit)");
+                     "unit '" + std::string(unit) + "' is not a unit of " + dimension_name(d) +
+                         " (" + expected + " or a compatible unit)");
   throw InputError(where, field, "unknown unit '" + std::string(unit) + "' (" + expected + ")");
 }
 

@@ -1,0 +1,50 @@
+#pragma once
+/// Measured against simulated observables: z-scores, chi-square, information criteria.
+/// z = (simulated - measured) / sqrt(s_meas^2 / n_meas + s_sim^2 / n_sim): the difference of two
+/// means over its standard error, with both standard deviations from repeats (the lab's, and the
+/// simulation's repeats with different seeds). A single simulation run (n_sim = 1, no spread) adds
+/// nothing to the denominator.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "clumpkit/calibrate/measurements.hpp"
+
+namespace clumpkit {
+
+/// Simulated observable: mean and standard deviation over `n` repeats (different seeds).
+struct SimulatedValue {
+  double mean = 0.0;
+  double std = 0.0;
+  int n = 1;
+};
+
+struct ObservableComparison {
+  Measurement measured;
+  SimulatedValue simulated;
+  double difference = 0.0;  ///< simulated - measured, canonical unit
+  double sigma = 0.0;       ///< combined standard error
+  double z = 0.0;
+  double rel_error = 0.0;   ///< difference / |measured|
+  bool pass = false;        ///< |z| <= 2
+};
+
+struct Comparison {
+  std::vector<ObservableComparison> observables;
+  double chi2 = 0.0;
+  int dof = 0;  ///< observables - fitted parameters (at least 1)
+  double chi2_per_dof = 0.0;
+  double bic = 0.0;  ///< chi2 + k ln N (Gaussian likelihood, constants dropped)
+  double aic = 0.0;  ///< chi2 + 2 k
+};
+
+/// `simulated` is keyed by Measurement::key(). Throws std::invalid_argument if one is missing
+/// (a programming error: the caller simulates what the measurements need).
+Comparison compare(const std::vector<Measurement>& measured,
+                   const std::map<std::string, SimulatedValue>& simulated,
+                   int fitted_parameters = 0);
+
+/// Mean and sample standard deviation of repeats.
+SimulatedValue summarize(const std::vector<double>& repeats);
+
+}  // namespace clumpkit

@@ -1,0 +1,49 @@
+#include "clumpkit/calibrate/comparison.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace clumpkit {
+
+SimulatedValue summarize(const std::vector<double>& r) {
+  SimulatedValue s;
+  s.n = static_cast<int>(r.size());
+  if (r.empty()) return s;
+  for (double v : r) s.mean += v;
+  s.mean /= static_cast<double>(r.size());
+  if (r.size() > 1) {
+    double var = 0;
+    for (double v : r) var += (v - s.mean) * (v - s.mean);
+    s.std = std::sqrt(var / static_cast<double>(r.size() - 1));
+  }
+  return s;
+}
+
+Comparison compare(const std::vector<Measurement>& measured,
+                   const std::map<std::string, SimulatedValue>& simulated, int k) {
+  Comparison c;
+  for (const Measurement& m : measured) {
+    auto it = simulated.find(m.key());
+    if (it == simulated.end()) throw std::invalid_argument("compare: no simulation for " + m.key());
+    ObservableComparison o;
+    o.measured = m;
+    o.simulated = it->second;
+    o.difference = o.simulated.mean - m.value;
+    const double var = m.std * m.std / m.n +
+                       (o.simulated.n > 0 ? o.simulated.std * o.simulated.std / o.simulated.n : 0.0);
+    o.sigma = std::sqrt(var);
+    o.z = o.difference / o.sigma;
+    o.rel_error = m.value != 0.0 ? o.difference / std::abs(m.value) : 0.0;
+    o.pass = std::abs(o.z) <= 2.0;
+    c.chi2 += o.z * o.z;
+    c.observables.push_back(o);
+  }
+  const int n = static_cast<int>(measured.size());
+  c.dof = std::max(1, n - k);
+  c.chi2_per_dof = c.chi2 / c.dof;
+  c.bic = c.chi2 + k * std::log(std::max(1, n));
+  c.aic = c.chi2 + 2.0 * k;
+  return c;
+}
+
+}  // namespace clumpkit

@@ -1,0 +1,127 @@
+#include "clumpkit/rigs/catalogue.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "clumpkit/core/error.hpp"
+
+namespace clumpkit {
+
+const QuantityInfo* RigInfo::quantity(const std::string& n) const {
+  for (const auto& q : quantities)
+    if (q.name == n) return &q;
+  return nullptr;
+}
+
+const SettingInfo* RigInfo::setting(const std::string& k) const {
+  for (const auto& s : settings)
+    if (s.key == k) return &s;
+  return nullptr;
+}
+
+const std::vector<RigInfo>& rig_catalogue() {
+  static const std::vector<RigInfo> rigs = [] {
+    const double deg = std::numbers::pi / 180.0;
+    const SettingInfo scale{"scale", {"mini", "small", "paper"}, "", "mini",
+                            "rig size: mini (quick), small, paper (the paper's sizes)"};
+    const std::vector<std::string> walls = {"abs_plastic", "organic_glass", "galvanized_steel"};
+    std::vector<RigInfo> r;
+    r.push_back({"bulk_density",
+                 "0.26 L organic-glass cylinder, pour to overflow, strike off, weigh",
+                 {{"bulk_density", Dimension::Density, "kg/m^3", 1.0, "mass in the cylinder / 0.26 L"}},
+                 {scale,
+                  {"wall", walls, "", "organic_glass", "material of the measuring cylinder"}}});
+    r.push_back({"angle_of_repose",
+                 "lifting cylinder (200 mm/min) on a plate; heap angle from side silhouettes",
+                 {{"angle", Dimension::Angle, "deg", deg, "mean of both flanks"},
+                  {"angle_left", Dimension::Angle, "deg", deg, "left flank"},
+                  {"angle_right", Dimension::Angle, "deg", deg, "right flank"}},
+                 {scale,
+                  {"plate", walls, "", "galvanized_steel", "material of the base plate"},
+                  {"lift_speed", {}, "mm/min", "200", "lifting speed of the cylinder"}}});
+    r.push_back({"discharge",
+                 "hopper and 8-pocket wheel at a given speed",
+                 {{"pocket_mass", Dimension::Mass, "kg", 1.0, "mean mass per pocket"},
+                  {"pocket_mass_cv", Dimension::Dimensionless, "1", 1.0,
+                   "coefficient of variation of the pocket mass"},
+                  {"mass_flow", Dimension::MassFlow, "kg/s", 1.0, "discharged mass per second"}},
+                 {scale, {"rpm", {}, "rpm", "15", "wheel speed"}}});
+    return r;
+  }();
+  return rigs;
+}
+
+const RigInfo& find_rig(const std::string& name, const std::string& where,
+                        const std::string& field) {
+  std::string known;
+  for (const auto& r : rig_catalogue()) {
+    if (r.name == name) return r;
+    known += (known.empty() ? "" : ", ") + r.name;
+  }
+  throw InputError(where, field, "unknown rig '" + name + "' (known: " + known + ")");
+}
+
+const std::vector<std::string>& known_samples() {
+  static const std::vector<std::string> s = {"A", "B", "C", "mix"};
+  return s;
+}
+
+std::map<std::string, std::string> parse_settings(const RigInfo& rig, const std::string& text,
+                                                  const std::string& where,
+                                                  const std::string& field) {
+  std::map<std::string, std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ';')) {
+    auto trim = [](std::string s) {
+      const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+      return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+    };
+    item = trim(item);
+    if (item.empty()) continue;
+    const auto eq = item.find('=');
+    if (eq == std::string::npos)
+      throw InputError(where, field, "'" + item + "' is not key=value");
+    const std::string key = trim(item.substr(0, eq)), value = trim(item.substr(eq + 1));
+    const SettingInfo* s = rig.setting(key);
+    if (!s) {
+      std::string known;
+      for (const auto& k : rig.settings) known += (known.empty() ? "" : ", ") + k.key;
+      throw InputError(where, field,
+                       "rig '" + rig.name + "' has no setting '" + key + "' (known: " + known + ")");
+    }
+    if (out.count(key)) throw InputError(where, field, "setting '" + key + "' given twice");
+    if (!s->choices.empty()) {
+      bool ok = false;
+      std::string known;
+      for (const auto& c : s->choices) {
+        ok |= c == value;
+        known += (known.empty() ? "" : ", ") + c;
+      }
+      if (!ok)
+        throw InputError(where, field,
+                         "setting " + key + "='" + value + "' is not one of: " + known);
+      out[key] = value;
+    } else {
+      char* end = nullptr;
+      const double v = std::strtod(value.c_str(), &end);
+      if (value.empty() || !end || *end != 0 || !std::isfinite(v) || v <= 0)
+        throw InputError(where, field,
+                         "setting " + key + "='" + value + "' must be a positive number in " +
+                             s->unit);
+      std::ostringstream num;
+      num << v;
+      out[key] = num.str();
+    }
+  }
+  return out;
+}
+
+std::string format_settings(const std::map<std::string, std::string>& settings) {
+  std::string s;
+  for (const auto& [k, v] : settings) s += (s.empty() ? "" : ";") + k + "=" + v;
+  return s;
+}
+
+}  // namespace clumpkit

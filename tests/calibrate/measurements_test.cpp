@@ -1,0 +1,101 @@
+#include "clumpkit/calibrate/measurements.hpp"
+
+#include <gtest/gtest.h>
+
+#include "clumpkit/core/error.hpp"
+
+using namespace clumpkit;
+
+namespace {
+const std::string kHeader = "rig,sample,setting,quantity,value,std,n,unit\n";
+std::string error_of(const std::string& body) {
+  try {
+    parse_measurements(kHeader + body, "m.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Measurements, ReadsTheSpecFormat) {
+  const auto m = parse_measurements(
+      "# lab, March\n" + kHeader +
+          "bulk_density,A,,bulk_density,712.4,6.1,3,kg/m^3\n"
+          "angle_of_repose,mix,plate=galvanized_steel,angle,27.3,0.8,3,deg\n"
+          "\n"
+          "discharge,mix,rpm=15,pocket_mass,240,5,3,g\n"
+          "discharge,mix,rpm=30,pocket_mass_cv,0.04,0.01,3,1\n",
+      "m.csv");
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_EQ(m[0].line, 3);
+  EXPECT_DOUBLE_EQ(m[0].value, 712.4);
+  EXPECT_EQ(m[1].setting.at("plate"), "galvanized_steel");
+  EXPECT_NEAR(m[2].value, 0.240, 1e-15);  // g converted to the canonical kg
+  EXPECT_NEAR(m[2].std, 0.005, 1e-15);
+  EXPECT_EQ(m[2].unit, "kg");
+  EXPECT_EQ(m[3].n, 3);
+}
+
+TEST(Measurements, ColumnsInAnyOrderAndExtraColumns) {
+  const auto m = parse_measurements(
+      "note,unit,n,std,value,quantity,setting,sample,rig\n"
+      "x,deg,3,1.0,25,angle,,A,angle_of_repose\n",
+      "m.csv");
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_EQ(m[0].rig, "angle_of_repose");
+}
+
+// Every bad line names the file, the line and the column.
+TEST(Measurements, BadLinesAreNamed) {
+  struct Case {
+    std::string body, needle;
+  };
+  const Case cases[] = {
+      {"heap,A,,angle,25,1,3,deg\n", "m.csv:2: rig: unknown rig 'heap'"},
+      {"angle_of_repose,D,,angle,25,1,3,deg\n", "m.csv:2: sample: unknown sample 'D'"},
+      {"angle_of_repose,A,,slope,25,1,3,deg\n", "m.csv:2: quantity: rig 'angle_of_repose' does not"},
+      {"angle_of_repose,A,rpm=10,angle,25,1,3,deg\n", "m.csv:2: setting: rig 'angle_of_repose' has no setting 'rpm'"},
+      {"discharge,mix,rpm=fast,pocket_mass,0.25,0.01,3,kg\n", "m.csv:2: setting: setting rpm='fast'"},
+      {"angle_of_repose,A,,angle,25,1,3,kg\n", "m.csv:2: unit: unit 'kg' is not a unit of angle"},
+      {"angle_of_repose,A,,angle,25,,3,deg\n", "m.csv:2: std: missing"},
+      {"angle_of_repose,A,,angle,25,-1,3,deg\n", "m.csv:2: std: must be positive"},
+      {"angle_of_repose,A,,angle,25,0,3,deg\n", "m.csv:2: std: must be positive"},
+      {"angle_of_repose,A,,angle,25,1,0,deg\n", "m.csv:2: n: must be a whole number"},
+      {"angle_of_repose,A,,angle,25,1,2.5,deg\n", "m.csv:2: n: must be a whole number"},
+      {"angle_of_repose,A,,angle,abc,1,3,deg\n", "m.csv:2: value: 'abc' is not a number"},
+      {"angle_of_repose,A,,angle,nan,1,3,deg\n", "m.csv:2: value: 'nan' is not finite"},
+      {"bulk_density,A,,bulk_density,-700,1,3,kg/m^3\n", "m.csv:2: value: must not be negative"},
+      {"angle_of_repose,A,,angle,25,1,3,deg\nangle_of_repose,A,,angle,26,1,3,deg\n",
+       "m.csv:3: duplicate of line 2"},
+      {"discharge,mix,rpm=15,pocket_mass,1,1,3,kg\ndischarge,mix,rpm=15.0,pocket_mass,1,1,3,kg\n",
+       "m.csv:3: duplicate of line 2"},
+      {"angle_of_repose,A,\"plate=abs_plastic,angle,25,1,3,deg\n", "m.csv:2: unterminated quote"},
+      {"", "m.csv: no measurements"},
+  };
+  for (const Case& c : cases) {
+    const std::string e = error_of(c.body);
+    EXPECT_NE(e.find(c.needle), std::string::npos) << "line: " << c.body << "got: " << e;
+  }
+  try {
+    parse_measurements("rig,sample,quantity,value,std,n,unit\n", "h.csv");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("h.csv:1: setting: missing column"), std::string::npos);
+  }
+  EXPECT_THROW(parse_measurements("", "e.csv"), InputError);
+}
+
+TEST(Measurements, FormatRoundTrips) {
+  const auto m = parse_measurements(kHeader +
+                                        "discharge,mix,rpm=15,pocket_mass,0.24,0.005,3,kg\n"
+                                        "angle_of_repose,C,plate=abs_plastic,angle_left,26.1,0.9,3,deg\n",
+                                    "m.csv");
+  const auto r = parse_measurements(format_measurements(m), "r.csv");
+  ASSERT_EQ(r.size(), m.size());
+  for (size_t i = 0; i < m.size(); ++i) {
+    EXPECT_EQ(r[i].key(), m[i].key());
+    EXPECT_DOUBLE_EQ(r[i].value, m[i].value);
+    EXPECT_DOUBLE_EQ(r[i].std, m[i].std);
+  }
+}
