@@ -1,0 +1,108 @@
+#pragma once
+/// The contact law of one material pair: Hertz–Mindlin (no-slip) as in the paper's eqs. (1)–(4)
+/// (SPEC §6), built from effects that are either present or absent. An absent effect is not in
+/// the physics at all (no spring, no history, no torque); a present effect with a zero value is
+/// still evaluated. The calibration module switches effects per pair (SPEC §8).
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "clumpkit/core/materials.hpp"
+
+namespace clumpkit::dem {
+
+/// How rolling resistance is modelled (SPEC §6).
+enum class RollingModel {
+  /// Paper eq. (2), EDEM "standard": constant directional torque −μr R |Fn| ω̂ on each clump,
+  /// R = radius of the sub-sphere in contact, ω = that clump's own angular velocity. The default.
+  kStandard,
+  /// LIGGGHTS `rolling_friction cdt`: −μr R* |Fn| ω̂_rel with ω_rel = ω_i − ω_j (wall: ω_wall).
+  kCdt,
+  /// Elastic–plastic spring–dashpot, "type C" (Ai et al. 2011): rolling spring
+  /// k_r = 2.25 S_n μr² R*², torque capped at μr R* |Fn|, viscous damping off at the cap.
+  kEpsd,
+};
+
+const char* to_string(RollingModel m);
+/// "standard", "cdt" or "epsd"; throws InputError(where, field) otherwise.
+RollingModel rolling_model_from_string(const std::string& s, const std::string& where = "",
+                                       const std::string& field = "");
+
+struct RollingFriction {
+  RollingModel model = RollingModel::kStandard;
+  double coefficient = 0.0;      ///< μr >= 0, dimensionless
+  double viscous_damping = 0.3;  ///< EPSD only: fraction of the critical rolling damping, >= 0
+};
+
+/// Simplified JKR (LIGGGHTS `cohesion sjkr`): attractive normal force k A while the spheres
+/// overlap, A = 2π R* δ (the area of the overlap circle for small δ).
+struct Cohesion {
+  double energy_density = 0.0;  ///< k, J/m^3 >= 0
+};
+
+/// The effects of one material pair. Every optional is one effect of the SPEC §8 catalogue:
+/// restitution (normal and tangential damping), friction (Mindlin spring + Coulomb cap; called
+/// particle_friction or wall_friction by pair kind), rolling_friction, cohesion.
+struct PairContact {
+  std::optional<double> restitution;      ///< e in (0, 1]; absent = undamped (elastic)
+  std::optional<double> static_friction;  ///< μs >= 0; absent = no tangential force at all
+  std::optional<RollingFriction> rolling;
+  std::optional<Cohesion> cohesion;
+
+  /// All effects of a library interaction present (cohesion absent).
+  static PairContact from(const Interaction& i, RollingModel model = RollingModel::kStandard);
+  /// Throws InputError(where, field + ".restitution" ...) for values out of range.
+  void validate(const std::string& where, const std::string& field) const;
+};
+
+/// A pair's law with the material constants folded in (what the force loop reads).
+struct ResolvedContact {
+  double e_star = 0.0;  ///< Pa, Y* = [(1−νi²)/Ei + (1−νj²)/Ej]^−1
+  double g_star = 0.0;  ///< Pa, G* = [Σ 2(2−ν)(1+ν)/E]^−1
+  bool damping = false;
+  double beta = 0.0;  ///< paper's β = −ln e / √(ln² e + π²) >= 0
+  bool friction = false;
+  double mu_s = 0.0;
+  bool rolling = false;
+  RollingFriction roll;
+  bool cohesion = false;
+  double cohesion_k = 0.0;
+};
+
+ResolvedContact resolve(const Material& a, const Material& b, const PairContact& law);
+
+/// Geometry and kinematics of one contact, body i against body j (j may be a wall).
+struct ContactKinematics {
+  Eigen::Vector3d normal;  ///< unit, from j towards i
+  double overlap = 0.0;    ///< δ > 0, m
+  double r_star = 0.0;     ///< m
+  double m_star = 0.0;     ///< kg
+  double radius_i = 0.0;   ///< sub-sphere radius of i (standard rolling), m
+  double radius_j = 0.0;   ///< of j, 0 for a wall
+  Eigen::Vector3d v_rel;    ///< velocity of i minus velocity of j at the contact point, m/s
+  Eigen::Vector3d omega_i;  ///< world angular velocity of clump i, rad/s
+  Eigen::Vector3d omega_j;  ///< of clump j or of the wall
+};
+
+/// Per-contact state that persists across steps (history springs), world frame.
+struct ContactHistory {
+  Eigen::Vector3d shear = Eigen::Vector3d::Zero();  ///< tangential spring displacement δt, m
+  Eigen::Vector3d roll = Eigen::Vector3d::Zero();   ///< EPSD rolling spring torque, N m
+};
+
+struct ContactForce {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on i (j gets −force), N
+  Eigen::Vector3d torque_i = Eigen::Vector3d::Zero();  ///< rolling torque on clump i, N m
+  Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();  ///< rolling torque on clump j, N m
+  double normal = 0.0;            ///< signed normal force (Hertz + damping + cohesion), N
+  double elastic_energy = 0.0;    ///< stored in the normal and tangential springs, J
+};
+
+/// Evaluates the law for one contact over a step of `dt`, updating the history springs.
+void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, double dt,
+                      ContactHistory& history, ContactForce& out);
+
+/// Keeps a history vector in the current tangent plane (normal `n`) and its length.
+Eigen::Vector3d project_to_tangent(const Eigen::Vector3d& v, const Eigen::Vector3d& n);
+
+}  // namespace clumpkit::dem

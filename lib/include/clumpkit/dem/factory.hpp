@@ -1,0 +1,58 @@
+#pragma once
+/// Insertion of clumps: box or cylinder regions, by count or mass, all at once or at a rate,
+/// random positions and orientations, non-overlapping, template mixture by mass fraction.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace clumpkit::dem {
+
+struct BoxRegion {
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();  ///< m
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();  ///< m
+};
+
+/// Axis +z through `base_center`.
+struct CylinderRegion {
+  Eigen::Vector3d base_center = Eigen::Vector3d::Zero();  ///< m
+  double radius = 0.0;                                     ///< m
+  double height = 0.0;                                     ///< m
+};
+
+using Region = std::variant<BoxRegion, CylinderRegion>;
+
+double region_volume(const Region& r);
+std::string describe(const Region& r);  ///< e.g. "box 20 x 20 x 20 mm"
+
+struct MixtureEntry {
+  std::string clump_type;
+  double mass_fraction = 1.0;  ///< normalised over the mixture
+};
+
+struct FactorySettings {
+  std::string name = "factory";
+  Region region = BoxRegion{};
+  std::vector<MixtureEntry> mixture;
+  std::optional<long> count;    ///< clumps to insert; exactly one of count and mass
+  std::optional<double> mass;   ///< kg to insert (stops at the clump that comes closest)
+  /// 0 = everything at start_time (an InputError when the region cannot hold it); otherwise
+  /// clumps/s (with count) or kg/s (with mass), inserted in batches every `interval`.
+  double rate = 0.0;
+  double start_time = 0.0;      ///< s
+  double interval = 0.0;        ///< s between batches; 0 = the free-fall time of the region
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< initial velocity, m/s
+  bool random_orientation = true;
+  int attempts_per_clump = 200;  ///< random placements tried before giving up on a clump
+};
+
+/// What a factory has done so far.
+struct FactoryStatus {
+  long inserted = 0;
+  double inserted_mass = 0.0;  ///< kg
+  bool done = false;
+  long failed_attempts = 0;    ///< placements rejected for overlap
+};
+
+}  // namespace clumpkit::dem

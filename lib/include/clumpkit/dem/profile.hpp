@@ -1,0 +1,26 @@
+#pragma once
+/// Wall-clock time spent in each stage of World::step, for the per-stage profile print.
+#include <string>
+
+namespace clumpkit::dem {
+
+struct Profile {
+  double integrate = 0.0;   ///< s, both velocity-Verlet halves
+  double walls = 0.0;       ///< s, wall motion
+  double insert = 0.0;      ///< s, factories
+  double neighbours = 0.0;  ///< s, cell lists and Verlet lists
+  double contacts = 0.0;    ///< s, sphere-sphere and sphere-triangle detection
+  double forces = 0.0;      ///< s, contact law and accumulation
+  double checks = 0.0;      ///< s, blow-up detection
+  double output = 0.0;      ///< s, filled in by callers that write files
+  long steps = 0;
+  long neighbour_rebuilds = 0;
+
+  double total() const {
+    return integrate + walls + insert + neighbours + contacts + forces + checks + output;
+  }
+  /// A small table: stage, seconds, share.
+  std::string table() const;
+};
+
+}  // namespace clumpkit::dem

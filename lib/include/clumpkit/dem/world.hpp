@@ -1,0 +1,187 @@
+#pragma once
+/// The bundled DEM runner: rigid multi-sphere clumps, Hertz–Mindlin contacts, moving triangle
+/// walls. Build a World from WorldSettings (validated once, InputError on bad input), then call
+/// step() or run_until(). SI units throughout; world frame z up unless gravity says otherwise.
+///
+/// Per-instance state is stored as arrays (structure of arrays). Angular velocity is stored in
+/// the clump's principal (body) frame; omega_world() converts. Positions are centres of mass.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "clumpkit/core/materials.hpp"
+#include "clumpkit/dem/contact_law.hpp"
+#include "clumpkit/dem/factory.hpp"
+#include "clumpkit/dem/profile.hpp"
+#include "clumpkit/dem/wall.hpp"
+#include "clumpkit/geometry/clump_template.hpp"
+
+namespace clumpkit::dem {
+
+/// A clump type: the template's spheres and union mass properties, shared by every instance.
+/// The template must be in (or is moved to) its centroid-principal frame; its mass is used as
+/// given (the mass basis is the template's choice, see SPEC §2).
+struct ClumpTypeSettings {
+  std::string name;
+  ClumpTemplate clump;
+  std::string material = "pill";
+};
+
+/// Replaces the library's contact law for one material pair (order of a, b irrelevant).
+struct PairContactOverride {
+  std::string material_a, material_b;
+  PairContact law;
+};
+
+struct WorldSettings {
+  /// Where the settings came from (scene file), used in InputError messages.
+  std::string source = "world settings";
+  MaterialLibrary materials = MaterialLibrary::paper_table1();
+  /// Pairs without an override use PairContact::from(library interaction, rolling_model).
+  RollingModel rolling_model = RollingModel::kStandard;
+  std::vector<PairContactOverride> pair_contacts;
+  std::vector<ClumpTypeSettings> clump_types;
+  std::vector<WallSettings> walls;
+  std::vector<FactorySettings> factories;
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};  ///< m/s^2
+
+  double time_step = 0.0;          ///< s; 0 = rayleigh_fraction × T_R of the smallest sphere
+  double rayleigh_fraction = 0.2;  ///< used when time_step = 0; a warning above 0.4
+  /// Largest impact speed expected (m/s): the Hertz contact time at this speed must span at
+  /// least 10 steps (InputError below 5, warning below 20).
+  double max_impact_speed = 2.0;
+  double skin = 0.0;  ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
+  int threads = 0;    ///< OpenMP threads; 0 = all
+  std::uint64_t seed = 1;  ///< factories' random stream
+
+  /// Blow-up detection: checked every `check_interval` steps.
+  int check_interval = 50;
+  double max_speed = 50.0;  ///< m/s; a clump faster than this is a blow-up
+};
+
+/// One wall's kinematic state and the load it carries (from the last force evaluation).
+struct WallState {
+  WallPose pose;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< exerted by the particles, N
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  ///< about the torque reference point, N m
+  Eigen::Vector3d torque_reference = Eigen::Vector3d::Zero();  ///< current, m
+};
+
+/// A sub-sphere contact, for diagnostics (coordination number, force chains).
+struct ContactInfo {
+  int clump_i = -1;
+  int clump_j = -1;  ///< −1 for a wall contact
+  int wall = -1;     ///< wall index for a wall contact
+  Eigen::Vector3d point;   ///< m
+  Eigen::Vector3d normal;  ///< unit, from j (or the wall) to i
+  double overlap = 0.0;    ///< m
+  Eigen::Vector3d force;   ///< on i, N
+};
+
+class World {
+ public:
+  /// Validates everything (materials, pair laws, templates, meshes, motions, factories, time
+  /// step) and throws InputError naming settings.source and the field on bad input.
+  [[nodiscard]] static World create(WorldSettings settings);
+
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+  ~World();
+
+  /// One time step: integrate (first half) → walls move → insert → neighbour update → contact
+  /// detection → forces → integrate (second half) → checks. Throws NumericalError with a
+  /// diagnosis on blow-up, InputError when a rate factory cannot keep up.
+  void step();
+  /// Steps until time() >= t (at most one step past).
+  void run_until(double t);
+
+  double time() const;
+  long step_count() const;
+  double dt() const;
+  /// Warnings raised at creation or while running (time step, factories), in order.
+  const std::vector<std::string>& warnings() const;
+  const Profile& profile() const;
+  Profile& profile();
+  const WorldSettings& settings() const;
+
+  // Clump types and instances.
+  int clump_type_count() const;
+  int clump_type_index(const std::string& name) const;  ///< InputError if unknown
+  const ClumpTypeSettings& clump_type(int t) const;
+  double clump_type_mass(int t) const;
+  Eigen::Vector3d clump_type_inertia(int t) const;  ///< principal moments, kg m^2
+
+  /// Adds a clump (centre of mass x, orientation q: body → world, velocity v, world angular
+  /// velocity w). Returns its index. Does not check overlaps.
+  int add_clump(int type, const Eigen::Vector3d& x,
+                const Eigen::Quaterniond& q = Eigen::Quaterniond::Identity(),
+                const Eigen::Vector3d& v = Eigen::Vector3d::Zero(),
+                const Eigen::Vector3d& w = Eigen::Vector3d::Zero());
+
+  int clump_count() const;
+  long sphere_count() const;
+  int clump_type_of(int c) const;
+  double clump_mass(int c) const;
+  const std::vector<Eigen::Vector3d>& positions() const;      ///< centres of mass, m
+  const std::vector<Eigen::Quaterniond>& orientations() const;  ///< body → world
+  const std::vector<Eigen::Vector3d>& velocities() const;       ///< m/s
+  const std::vector<Eigen::Vector3d>& omegas_body() const;      ///< rad/s, principal frame
+  Eigen::Vector3d omega_world(int c) const;                     ///< rad/s
+  void set_velocity(int c, const Eigen::Vector3d& v);
+  void set_omega_world(int c, const Eigen::Vector3d& w);
+  /// Net contact force / torque on each clump from the last evaluation (no gravity), world frame.
+  const std::vector<Eigen::Vector3d>& contact_forces() const;
+  const std::vector<Eigen::Vector3d>& contact_torques() const;
+  /// World positions and radii of all sub-spheres (updated every step), and their clump ids.
+  const std::vector<Eigen::Vector3d>& sphere_positions() const;
+  const std::vector<double>& sphere_radii() const;
+  const std::vector<int>& sphere_clumps() const;
+
+  // Walls.
+  int wall_count() const;
+  int wall_index(const std::string& name) const;  ///< InputError if unknown
+  const WallSettings& wall_settings(int w) const;
+  const WallState& wall(int w) const;
+  /// Current world vertices of wall w.
+  const std::vector<Eigen::Vector3d>& wall_vertices(int w) const;
+
+  // Factories.
+  int factory_count() const;
+  const FactoryStatus& factory_status(int f) const;
+  bool factories_done() const;
+
+  // Contacts and energy.
+  /// Active sub-sphere contacts after the last force evaluation, in a fixed order.
+  std::vector<ContactInfo> contacts() const;
+  int contact_count() const;
+  double kinetic_energy() const;     ///< J, translational + rotational
+  double potential_energy() const;   ///< J, −Σ m g·x
+  double elastic_energy() const;     ///< J, stored in the contact springs (last evaluation)
+  double total_mass() const;         ///< kg
+
+  /// FNV-1a over the full dynamic state (time, positions, orientations, velocities, contact
+  /// histories, wall poses, factory progress). Equal hashes = bit-identical states.
+  std::uint64_t state_hash() const;
+
+  /// The full state, including contact histories and factory random streams. Loading requires
+  /// a World created from the same settings (a fingerprint is checked: InputError otherwise).
+  void save_checkpoint(const std::filesystem::path& path) const;
+  void load_checkpoint(const std::filesystem::path& path);
+
+  /// The contact law in force for a material pair, resolved.
+  const ResolvedContact& resolved_contact(const std::string& a, const std::string& b) const;
+
+  struct Impl;
+
+ private:
+  explicit World(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clumpkit::dem

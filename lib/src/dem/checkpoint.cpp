@@ -1,0 +1,207 @@
+// Checkpoints: the complete dynamic state in a binary file (written atomically), so that a
+// resumed run continues bit-identically.
+#include <cstring>
+#include <sstream>
+
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+#include "dem/world_impl.hpp"
+
+namespace clumpkit::dem {
+
+namespace {
+
+constexpr char kMagic[] = "clumpkit-dem-checkpoint/1";
+
+struct Writer {
+  std::string buf;
+  void bytes(const void* p, size_t n) { buf.append(static_cast<const char*>(p), n); }
+  template <class T>
+  void value(const T& v) {
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    value<std::uint64_t>(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+  void str(const std::string& s) {
+    value<std::uint64_t>(s.size());
+    bytes(s.data(), s.size());
+  }
+};
+
+struct Reader {
+  const std::string& buf;
+  size_t at = 0;
+  std::string where;
+  void bytes(void* p, size_t n) {
+    if (at + n > buf.size()) throw InputError(where, "", "checkpoint is truncated");
+    std::memcpy(p, buf.data() + at, n);
+    at += n;
+  }
+  template <class T>
+  void value(T& v) {
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void vec(std::vector<T>& v) {
+    std::uint64_t n = 0;
+    value(n);
+    if (n > buf.size()) throw InputError(where, "", "checkpoint is corrupt");
+    v.resize(n);
+    if (n) bytes(v.data(), n * sizeof(T));
+  }
+  void str(std::string& s) {
+    std::uint64_t n = 0;
+    value(n);
+    if (n > buf.size()) throw InputError(where, "", "checkpoint is corrupt");
+    s.resize(n);
+    if (n) bytes(s.data(), n);
+  }
+};
+
+}  // namespace
+
+void World::save_checkpoint(const std::filesystem::path& path) const {
+  const Impl& w = *impl_;
+  Writer o;
+  o.bytes(kMagic, sizeof kMagic);
+  o.value(w.fingerprint);
+  o.value(w.time);
+  o.value(w.steps);
+  o.vec(w.c_type);
+  o.vec(w.c_x);
+  o.vec(w.c_v);
+  o.vec(w.c_wb);
+  o.vec(w.c_q);
+  o.vec(w.c_f);
+  o.vec(w.c_t);
+  o.vec(w.c_troll);
+  o.vec(w.s_pos_build);
+  o.vec(w.pairs);
+  o.vec(w.pair_hist);
+  o.vec(w.wall_cand_start);
+  o.vec(w.wall_cand);
+  o.vec(w.wall_slots);
+  o.value(w.need_rebuild);
+  o.value(w.forces_valid);
+  o.value(w.elastic);
+  for (const WallData& wd : w.walls) {
+    o.vec(wd.vertices_build);
+    o.value(wd.state.force);
+    o.value(wd.state.torque);
+  }
+  for (const FactoryRuntime& f : w.factories) {
+    o.vec(f.type_mass);
+    o.value(f.status);
+    o.value(f.batch);
+    o.value(f.interval);
+    std::ostringstream rng;
+    rng << f.rng;
+    o.str(rng.str());
+  }
+  o.value(w.check_energy);
+  o.value(w.check_ke);
+  o.value(w.check_elastic);
+  o.value(w.wall_work);
+  o.value(w.inserted_energy);
+  o.value(w.check_initialised);
+  write_file_atomic(path, o.buf);
+}
+
+void World::load_checkpoint(const std::filesystem::path& path) {
+  const std::string data = read_file(path);
+  Reader in{data, 0, path.string()};
+  char magic[sizeof kMagic];
+  in.bytes(magic, sizeof magic);
+  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw InputError(path.string(), "", "not a clumpkit DEM checkpoint");
+  Impl& w = *impl_;
+  std::uint64_t fp = 0;
+  in.value(fp);
+  if (fp != w.fingerprint)
+    throw InputError(path.string(), "",
+                     "the checkpoint was written by a simulation with other settings (clump "
+                     "types, walls, time step, factories or seed differ)");
+  in.value(w.time);
+  in.value(w.steps);
+  std::vector<int> types;
+  in.vec(types);
+  // Rebuild the sphere arrays from the clumps, then overwrite the dynamic state.
+  w.c_type.clear();
+  w.c_first.clear();
+  w.c_x.clear();
+  w.c_v.clear();
+  w.c_q.clear();
+  w.c_R.clear();
+  w.c_wb.clear();
+  w.c_f.clear();
+  w.c_t.clear();
+  w.c_troll.clear();
+  w.s_clump.clear();
+  w.s_r.clear();
+  w.s_off.clear();
+  w.s_pos.clear();
+  w.s_pos_build.clear();
+  w.wall_slots.clear();
+  w.wall_contacts.clear();
+  w.wall_contact_n.clear();
+  w.wall_cand_start.assign(1, 0);
+  for (int t : types) {
+    if (t < 0 || t >= static_cast<int>(w.types.size()))
+      throw InputError(path.string(), "", "checkpoint is corrupt (clump type)");
+    w.add_clump(t, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(),
+                Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  }
+  in.vec(w.c_x);
+  in.vec(w.c_v);
+  in.vec(w.c_wb);
+  in.vec(w.c_q);
+  in.vec(w.c_f);
+  in.vec(w.c_t);
+  in.vec(w.c_troll);
+  in.vec(w.s_pos_build);
+  in.vec(w.pairs);
+  in.vec(w.pair_hist);
+  in.vec(w.wall_cand_start);
+  in.vec(w.wall_cand);
+  in.vec(w.wall_slots);
+  in.value(w.need_rebuild);
+  in.value(w.forces_valid);
+  in.value(w.elastic);
+  const size_t nc = types.size();
+  if (w.c_x.size() != nc || w.c_v.size() != nc || w.c_q.size() != nc ||
+      w.s_pos_build.size() != w.s_r.size() || w.wall_slots.size() != w.s_r.size() ||
+      w.wall_cand_start.size() != w.s_r.size() + 1 || w.pair_hist.size() != w.pairs.size())
+    throw InputError(path.string(), "", "checkpoint is corrupt (array sizes)");
+  for (size_t c = 0; c < nc; ++c) w.c_R[c] = w.c_q[c].toRotationMatrix();
+  w.update_spheres(0);
+  w.move_walls();
+  for (WallData& wd : w.walls) {
+    in.vec(wd.vertices_build);
+    in.value(wd.state.force);
+    in.value(wd.state.torque);
+  }
+  for (FactoryRuntime& f : w.factories) {
+    in.vec(f.type_mass);
+    in.value(f.status);
+    in.value(f.batch);
+    in.value(f.interval);
+    std::string rng;
+    in.str(rng);
+    std::istringstream is(rng);
+    is >> f.rng;
+  }
+  in.value(w.check_energy);
+  in.value(w.check_ke);
+  in.value(w.check_elastic);
+  in.value(w.wall_work);
+  in.value(w.inserted_energy);
+  in.value(w.check_initialised);
+  // The contacts of the saved step are re-detected (detection is a pure function of positions
+  // and histories are already restored): nothing else needs them before the next force pass.
+  w.pair_contacts.clear();
+}
+
+}  // namespace clumpkit::dem

@@ -1,0 +1,155 @@
+// Cell lists with a Verlet skin. Sphere pairs (i < j, different clumps) closer than
+// r_i + r_j + skin, and sphere-triangle candidates closer than r + skin, are listed at a
+// rebuild; the lists stay valid until a sphere (or wall vertex) has moved far enough to close
+// the skin. Everything is built in a fixed order, so lists are identical for any thread count.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "dem/world_impl.hpp"
+
+namespace clumpkit::dem {
+
+namespace {
+
+constexpr std::int64_t kBias = 1 << 20;
+
+std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
+  return (static_cast<std::uint64_t>(x + kBias) << 42) |
+         (static_cast<std::uint64_t>(y + kBias) << 21) | static_cast<std::uint64_t>(z + kBias);
+}
+
+std::int64_t cell_of(double v, double cell) {
+  const double c = std::floor(v / cell);
+  return static_cast<std::int64_t>(std::clamp(c, double(-kBias + 2), double(kBias - 2)));
+}
+
+}  // namespace
+
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  // Voronoi regions of the vertices, edges and face, in barycentric terms.
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+void World::Impl::rebuild_neighbours() {
+  const int ns = static_cast<int>(s_r.size());
+  const double h = cell > 0.0 ? cell : 1.0;
+
+  // Spheres sorted by cell.
+  std::vector<std::pair<std::uint64_t, int>> bins(ns);
+  std::vector<std::array<std::int64_t, 3>> sc(ns);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int s = 0; s < ns; ++s) {
+    sc[s] = {cell_of(s_pos[s].x(), h), cell_of(s_pos[s].y(), h), cell_of(s_pos[s].z(), h)};
+    bins[s] = {cell_key(sc[s][0], sc[s][1], sc[s][2]), s};
+  }
+  std::sort(bins.begin(), bins.end());
+  auto range = [&](std::uint64_t key) {
+    auto lo = std::lower_bound(bins.begin(), bins.end(), std::make_pair(key, -1));
+    auto hi = lo;
+    while (hi != bins.end() && hi->first == key) ++hi;
+    return std::make_pair(lo, hi);
+  };
+
+  // Sphere pairs, per sphere i the sorted list of j > i.
+  std::vector<std::vector<int>> near(ns);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  for (int i = 0; i < ns; ++i) {
+    auto& out = near[i];
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto [lo, hi] = range(cell_key(sc[i][0] + dx, sc[i][1] + dy, sc[i][2] + dz));
+          for (auto it = lo; it != hi; ++it) {
+            const int j = it->second;
+            if (j <= i || s_clump[j] == s_clump[i]) continue;
+            const double rr = s_r[i] + s_r[j] + skin;
+            if ((s_pos[i] - s_pos[j]).squaredNorm() < rr * rr) out.push_back(j);
+          }
+        }
+    std::sort(out.begin(), out.end());
+  }
+  std::vector<PairEntry> next;
+  for (int i = 0; i < ns; ++i)
+    for (int j : near[i]) next.push_back({i, j});
+  // Carry histories over (both lists are sorted by (i, j)).
+  std::vector<ContactHistory> next_hist(next.size());
+  size_t a = 0;
+  for (size_t k = 0; k < next.size(); ++k) {
+    while (a < pairs.size() && (pairs[a].i < next[k].i ||
+                                (pairs[a].i == next[k].i && pairs[a].j < next[k].j)))
+      ++a;
+    if (a < pairs.size() && pairs[a].i == next[k].i && pairs[a].j == next[k].j)
+      next_hist[k] = pair_hist[a];
+  }
+  pairs.swap(next);
+  pair_hist.swap(next_hist);
+
+  // Wall triangles binned into the cells their (grown) bounding boxes touch.
+  std::vector<std::pair<std::uint64_t, std::array<int, 2>>> tri_bins;
+  const double grow = r_max + skin;
+  for (size_t wi = 0; wi < walls.size(); ++wi) {
+    const WallData& wd = walls[wi];
+    for (size_t ti = 0; ti < wd.triangles.size(); ++ti) {
+      const auto& t = wd.triangles[ti];
+      Eigen::Vector3d lo = wd.vertices[t[0]].cwiseMin(wd.vertices[t[1]]).cwiseMin(wd.vertices[t[2]]);
+      Eigen::Vector3d hi = wd.vertices[t[0]].cwiseMax(wd.vertices[t[1]]).cwiseMax(wd.vertices[t[2]]);
+      lo.array() -= grow;
+      hi.array() += grow;
+      const std::int64_t x0 = cell_of(lo.x(), h), x1 = cell_of(hi.x(), h);
+      const std::int64_t y0 = cell_of(lo.y(), h), y1 = cell_of(hi.y(), h);
+      const std::int64_t z0 = cell_of(lo.z(), h), z1 = cell_of(hi.z(), h);
+      for (std::int64_t x = x0; x <= x1; ++x)
+        for (std::int64_t y = y0; y <= y1; ++y)
+          for (std::int64_t z = z0; z <= z1; ++z)
+            tri_bins.push_back({cell_key(x, y, z), {int(wi), int(ti)}});
+    }
+  }
+  std::sort(tri_bins.begin(), tri_bins.end());
+  std::vector<std::vector<std::array<int, 2>>> cand(ns);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  for (int s = 0; s < ns; ++s) {
+    const std::uint64_t key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
+    auto lo = std::lower_bound(tri_bins.begin(), tri_bins.end(),
+                               std::make_pair(key, std::array<int, 2>{-1, -1}));
+    const double reach = s_r[s] + skin;
+    for (auto it = lo; it != tri_bins.end() && it->first == key; ++it) {
+      const auto [wi, ti] = it->second;
+      const WallData& wd = walls[wi];
+      const auto& t = wd.triangles[ti];
+      const Eigen::Vector3d c = closest_point_on_triangle(s_pos[s], wd.vertices[t[0]],
+                                                          wd.vertices[t[1]], wd.vertices[t[2]]);
+      if ((c - s_pos[s]).squaredNorm() < reach * reach) cand[s].push_back(it->second);
+    }
+  }
+  wall_cand.clear();
+  wall_cand_start.assign(ns + 1, 0);
+  for (int s = 0; s < ns; ++s) {
+    wall_cand.insert(wall_cand.end(), cand[s].begin(), cand[s].end());
+    wall_cand_start[s + 1] = static_cast<int>(wall_cand.size());
+  }
+
+  s_pos_build = s_pos;
+  for (WallData& wd : walls) wd.vertices_build = wd.vertices;
+  need_rebuild = false;
+}
+
+}  // namespace clumpkit::dem

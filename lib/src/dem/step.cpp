@@ -1,0 +1,457 @@
+// World::step and its stages. Integration is velocity Verlet for translation and, for rotation,
+// the symmetric splitting of the free rigid body into rotations about the principal axes
+// (Dullweber, Leimkuhler & McLachlan 1997), which keeps the gyroscopic term exact per sub-step.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "clumpkit/core/error.hpp"
+#include "dem/world_impl.hpp"
+
+namespace clumpkit::dem {
+
+namespace {
+
+double seconds_since(Clock::time_point& t0) {
+  const auto t1 = Clock::now();
+  const double s = std::chrono::duration<double>(t1 - t0).count();
+  t0 = t1;
+  return s;
+}
+
+std::string fmt_g(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+// Body angular momentum π rotated by −θ about principal axis k (the body turns by +θ).
+void rotate_momentum(Eigen::Vector3d& pi, int k, double theta) {
+  const int a = (k + 1) % 3, b = (k + 2) % 3;
+  const double c = std::cos(theta), s = std::sin(theta);
+  const double pa = pi[a], pb = pi[b];
+  pi[a] = c * pa + s * pb;
+  pi[b] = -s * pa + c * pb;
+}
+
+}  // namespace
+
+void World::step() {
+  Impl& w = *impl_;
+  w.ensure_forces();
+  auto t0 = Clock::now();
+  w.kick_and_drift();
+  w.time += w.dt;
+  ++w.steps;
+  w.profile.integrate += seconds_since(t0);
+  w.move_walls();
+  w.profile.walls += seconds_since(t0);
+  w.run_factories();
+  w.profile.insert += seconds_since(t0);
+  w.update_neighbours();
+  w.profile.neighbours += seconds_since(t0);
+  w.detect_contacts();
+  w.profile.contacts += seconds_since(t0);
+  w.compute_forces(w.dt);
+  w.profile.forces += seconds_since(t0);
+  w.kick();
+  w.profile.integrate += seconds_since(t0);
+  w.check_health();
+  w.profile.checks += seconds_since(t0);
+  ++w.profile.steps;
+}
+
+void World::run_until(double t) {
+  while (impl_->time < t - 1e-12 * impl_->dt) step();
+}
+
+void World::Impl::ensure_forces() {
+  if (forces_valid) return;
+  update_neighbours();
+  detect_contacts();
+  compute_forces(0.0);  // no history increment: the springs start at rest
+  forces_valid = true;
+  if (!check_initialised) {
+    check_energy = kinetic_energy() + potential_energy() + elastic;
+    check_ke = kinetic_energy();
+    check_elastic = elastic;
+    wall_work = inserted_energy = 0.0;
+    check_initialised = true;
+  }
+}
+
+void World::Impl::update_spheres(int first_clump) {
+  const int n0 = first_clump < static_cast<int>(c_first.size()) ? c_first[first_clump]
+                                                                 : static_cast<int>(s_r.size());
+  const int ns = static_cast<int>(s_r.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int s = n0; s < ns; ++s) {
+    const int c = s_clump[s];
+    s_pos[s] = c_x[c] + c_R[c] * s_off[s];
+  }
+}
+
+// Half kick of momentum and angular momentum. Rolling resistance (standard model) is applied
+// after the other torques and limited so that it can stop a rotation but never reverse it.
+static inline void half_kick(World::Impl& w, int c, double h) {
+  const TypeData& t = w.types[w.c_type[c]];
+  w.c_v[c] += h * (w.c_f[c] / t.mass + w.settings.gravity);
+  Eigen::Vector3d pi = t.inertia.cwiseProduct(w.c_wb[c]);
+  pi += h * (w.c_R[c].transpose() * w.c_t[c]);
+  if (!w.c_troll[c].isZero(0.0)) {
+    Eigen::Vector3d dpi = h * (w.c_R[c].transpose() * w.c_troll[c]);
+    const Eigen::Vector3d w0 = pi.cwiseQuotient(t.inertia);
+    const double wn = w0.norm();
+    if (wn > 0.0) {
+      const double along = -dpi.cwiseQuotient(t.inertia).dot(w0) / wn;
+      if (along > wn) dpi *= wn / along;
+      pi += dpi;
+    }
+  }
+  w.c_wb[c] = pi.cwiseQuotient(t.inertia);
+}
+
+void World::Impl::kick_and_drift() {
+  const int nc = static_cast<int>(c_x.size());
+  const double h = 0.5 * dt;
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int c = 0; c < nc; ++c) {
+    half_kick(*this, c, h);
+    c_x[c] += dt * c_v[c];
+    // Free rotation over dt: R1(h) R2(h) R3(dt) R2(h) R1(h) in the principal frame.
+    const Eigen::Vector3d& inertia = types[c_type[c]].inertia;
+    Eigen::Vector3d pi = inertia.cwiseProduct(c_wb[c]);
+    Eigen::Quaterniond q = c_q[c];
+    static constexpr int kAxis[5] = {0, 1, 2, 1, 0};
+    for (int s = 0; s < 5; ++s) {
+      const int k = kAxis[s];
+      const double tau = s == 2 ? dt : h;
+      const double theta = tau * pi[k] / inertia[k];
+      if (theta == 0.0) continue;
+      rotate_momentum(pi, k, theta);
+      q = q * Eigen::Quaterniond(Eigen::AngleAxisd(theta, Eigen::Vector3d::Unit(k)));
+    }
+    q.normalize();
+    c_q[c] = q;
+    c_R[c] = q.toRotationMatrix();
+    c_wb[c] = pi.cwiseQuotient(inertia);
+  }
+  update_spheres(0);
+}
+
+void World::Impl::kick() {
+  const int nc = static_cast<int>(c_x.size());
+  const double h = 0.5 * dt;
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int c = 0; c < nc; ++c) half_kick(*this, c, h);
+}
+
+void World::Impl::move_walls() {
+  for (WallData& wd : walls) {
+    const WallPose pose = wall_pose(wd.motion, time);
+    wd.state.pose = pose;
+    wd.state.torque_reference = wd.torque_reference0 + (pose.axis_point - pose.reference_point);
+    wd.vertices.resize(wd.ref_vertices.size());
+    for (size_t k = 0; k < wd.ref_vertices.size(); ++k)
+      wd.vertices[k] = pose.apply(wd.ref_vertices[k]);
+  }
+}
+
+void World::Impl::update_neighbours() {
+  const int ns = static_cast<int>(s_r.size());
+  double ds = 0.0;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(max : ds)
+  for (int s = 0; s < ns; ++s) ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+  ds = std::sqrt(ds);
+  double dw = 0.0;
+  for (const WallData& wd : walls)
+    for (size_t k = 0; k < wd.vertices.size(); ++k)
+      dw = std::max(dw, (wd.vertices[k] - wd.vertices_build[k]).squaredNorm());
+  dw = std::sqrt(dw);
+  if (need_rebuild || 2.0 * ds > skin || ds + dw > skin) {
+    rebuild_neighbours();
+    ++profile.neighbour_rebuilds;
+  }
+}
+
+void World::Impl::detect_contacts() {
+  // Sphere pairs: flag in parallel, compact in order.
+  const int np = static_cast<int>(pairs.size());
+  std::vector<double> dist(np);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int k = 0; k < np; ++k) {
+    const PairEntry& p = pairs[k];
+    const double rr = s_r[p.i] + s_r[p.j];
+    const double d2 = (s_pos[p.i] - s_pos[p.j]).squaredNorm();
+    if (d2 < rr * rr) {
+      dist[k] = std::sqrt(d2);
+    } else {
+      dist[k] = -1.0;
+      pair_hist[k] = ContactHistory{};
+    }
+  }
+  pair_contacts.clear();
+  max_overlap_ratio = 0.0;
+  for (int k = 0; k < np; ++k) {
+    if (dist[k] < 0.0) continue;
+    const PairEntry& p = pairs[k];
+    PairContactData pc;
+    pc.pair = k;
+    const double d = dist[k];
+    pc.overlap = s_r[p.i] + s_r[p.j] - d;
+    pc.normal = d > 0.0 ? Eigen::Vector3d((s_pos[p.i] - s_pos[p.j]) / d)
+                        : Eigen::Vector3d::UnitZ();
+    pc.point = s_pos[p.i] - (s_r[p.i] - 0.5 * pc.overlap) * pc.normal;
+    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
+    if (ratio > max_overlap_ratio) {
+      max_overlap_ratio = ratio;
+      max_overlap_what = "clumps " + std::to_string(s_clump[p.i]) + " and " +
+                         std::to_string(s_clump[p.j]);
+    }
+    pair_contacts.push_back(pc);
+  }
+
+  // Sphere-wall contacts, one sphere at a time. Candidates closer than the radius are sorted
+  // by distance; a candidate whose contact point lies on or behind the tangent plane of an
+  // already accepted contact, or whose normal is within 10° of it, is the same contact seen
+  // through another triangle of the same (nearly) flat region, a shared edge or a vertex, and
+  // is dropped. A sphere therefore feels one contact per smooth region of a wall.
+  const int ns = static_cast<int>(s_r.size());
+  const double merge_cos = std::cos(10.0 * 3.14159265358979323846 / 180.0);
+  std::vector<double> ratio_s(ns, 0.0);
+  std::vector<int> overflow(ns, 0);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  for (int s = 0; s < ns; ++s) {
+    struct Cand {
+      double dist;
+      int wall, tri;
+      Eigen::Vector3d point;
+    };
+    Cand cands[32];
+    int nc = 0;
+    const Eigen::Vector3d& p = s_pos[s];
+    const double r = s_r[s];
+    for (int k = wall_cand_start[s]; k < wall_cand_start[s + 1] && nc < 32; ++k) {
+      const auto [wi, ti] = wall_cand[k];
+      const WallData& wd = walls[wi];
+      const auto& tri = wd.triangles[ti];
+      const Eigen::Vector3d c =
+          closest_point_on_triangle(p, wd.vertices[tri[0]], wd.vertices[tri[1]], wd.vertices[tri[2]]);
+      const double d = (p - c).norm();
+      if (d < r) cands[nc++] = {d, wi, ti, c};
+    }
+    std::sort(cands, cands + nc, [](const Cand& a, const Cand& b) {
+      if (a.dist != b.dist) return a.dist < b.dist;
+      if (a.wall != b.wall) return a.wall < b.wall;
+      return a.tri < b.tri;
+    });
+    auto& out = wall_contacts[s];
+    int n = 0;
+    for (int k = 0; k < nc; ++k) {
+      const Cand& cd = cands[k];
+      Eigen::Vector3d normal;
+      if (cd.dist > 0.0) {
+        normal = (p - cd.point) / cd.dist;
+      } else {  // centre exactly on the triangle: use the face normal
+        const WallData& wd = walls[cd.wall];
+        const auto& tri = wd.triangles[cd.tri];
+        normal = (wd.vertices[tri[1]] - wd.vertices[tri[0]])
+                     .cross(wd.vertices[tri[2]] - wd.vertices[tri[0]])
+                     .normalized();
+      }
+      bool same = false;
+      for (int j = 0; j < n && !same; ++j)
+        same = (cd.point - out[j].point).dot(out[j].normal) <= 1e-9 * r ||
+               normal.dot(out[j].normal) >= merge_cos;
+      if (same) continue;
+      if (n == kWallSlots) {
+        overflow[s] = 1;
+        break;
+      }
+      WallContactData& wc = out[n++];
+      wc.wall = cd.wall;
+      wc.normal = normal;
+      wc.point = cd.point;
+      wc.overlap = r - cd.dist;
+      ratio_s[s] = std::max(ratio_s[s], wc.overlap / r);
+    }
+    // Carry the history springs over: same wall, closest normal.
+    std::array<WallSlot, kWallSlots> next{};
+    std::array<bool, kWallSlots> used{};
+    const auto& prev = wall_slots[s];
+    for (int k = 0; k < n; ++k) {
+      int best = -1;
+      double best_dot = 0.5;
+      for (int j = 0; j < kWallSlots; ++j)
+        if (!used[j] && prev[j].wall == out[k].wall) {
+          const double dd = prev[j].normal.dot(out[k].normal);
+          if (dd > best_dot) best_dot = dd, best = j;
+        }
+      next[k].wall = out[k].wall;
+      next[k].normal = out[k].normal;
+      if (best >= 0) {
+        used[best] = true;
+        next[k].history = prev[best].history;
+      }
+    }
+    wall_slots[s] = next;
+    wall_contact_n[s] = n;
+  }
+  for (int s = 0; s < ns; ++s) {
+    if (ratio_s[s] > max_overlap_ratio) {
+      max_overlap_ratio = ratio_s[s];
+      max_overlap_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
+                         walls[wall_contacts[s][0].wall].name + "'";
+      for (int k = 0; k < wall_contact_n[s]; ++k)
+        if (wall_contacts[s][k].overlap / s_r[s] >= ratio_s[s])
+          max_overlap_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
+                             walls[wall_contacts[s][k].wall].name + "'";
+    }
+    if (overflow[s] && !slot_overflow_warned) {
+      slot_overflow_warned = true;
+      warnings.push_back("a sphere touched more than " + std::to_string(kWallSlots) +
+                         " separate wall regions at t = " + fmt_g(time) +
+                         " s; the extra contacts were ignored");
+    }
+  }
+}
+
+void World::Impl::compute_forces(double hdt) {
+  const int nc = static_cast<int>(c_x.size());
+  c_ww.resize(nc);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int c = 0; c < nc; ++c) c_ww[c] = c_R[c] * c_wb[c];
+
+  const int npc = static_cast<int>(pair_contacts.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int k = 0; k < npc; ++k) {
+    PairContactData& pc = pair_contacts[k];
+    const PairEntry& p = pairs[pc.pair];
+    const int ci = s_clump[p.i], cj = s_clump[p.j];
+    const TypeData& ti = types[c_type[ci]];
+    const TypeData& tj = types[c_type[cj]];
+    ContactKinematics kin;
+    kin.normal = pc.normal;
+    kin.overlap = pc.overlap;
+    kin.r_star = s_r[p.i] * s_r[p.j] / (s_r[p.i] + s_r[p.j]);
+    kin.m_star = ti.mass * tj.mass / (ti.mass + tj.mass);
+    kin.radius_i = s_r[p.i];
+    kin.radius_j = s_r[p.j];
+    kin.omega_i = c_ww[ci];
+    kin.omega_j = c_ww[cj];
+    kin.v_rel = (c_v[ci] + c_ww[ci].cross(pc.point - c_x[ci])) -
+                (c_v[cj] + c_ww[cj].cross(pc.point - c_x[cj]));
+    evaluate_contact(law(ti.material, tj.material), kin, hdt, pair_hist[pc.pair], pc.out);
+  }
+
+  const int ns = static_cast<int>(s_r.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256)
+  for (int s = 0; s < ns; ++s) {
+    const int n = wall_contact_n[s];
+    if (n == 0) continue;
+    const int c = s_clump[s];
+    const TypeData& t = types[c_type[c]];
+    for (int k = 0; k < n; ++k) {
+      WallContactData& wc = wall_contacts[s][k];
+      const WallData& wd = walls[wc.wall];
+      ContactKinematics kin;
+      kin.normal = wc.normal;
+      kin.overlap = wc.overlap;
+      kin.r_star = s_r[s];
+      kin.m_star = t.mass;
+      kin.radius_i = s_r[s];
+      kin.radius_j = 0.0;
+      kin.omega_i = c_ww[c];
+      kin.omega_j = wd.state.pose.omega;
+      kin.v_rel = c_v[c] + c_ww[c].cross(wc.point - c_x[c]) - wd.state.pose.velocity_at(wc.point);
+      evaluate_contact(law(t.material, wd.material), kin, hdt, wall_slots[s][k].history, wc.out);
+    }
+  }
+
+  // Deterministic accumulation in a fixed order (pairs by (i, j), then spheres by index), so the
+  // sums do not depend on the thread count.
+  for (int c = 0; c < nc; ++c) {
+    c_f[c].setZero();
+    c_t[c].setZero();
+    c_troll[c].setZero();
+  }
+  for (WallData& wd : walls) {
+    wd.state.force.setZero();
+    wd.state.torque.setZero();
+  }
+  elastic = 0.0;
+  auto add_roll = [&](int c, const Eigen::Vector3d& tq, const ResolvedContact& lw) {
+    if (lw.roll.model == RollingModel::kStandard)
+      c_troll[c] += tq;
+    else
+      c_t[c] += tq;
+  };
+  for (const PairContactData& pc : pair_contacts) {
+    const PairEntry& p = pairs[pc.pair];
+    const int ci = s_clump[p.i], cj = s_clump[p.j];
+    const Eigen::Vector3d& f = pc.out.force;
+    c_f[ci] += f;
+    c_f[cj] -= f;
+    c_t[ci] += (pc.point - c_x[ci]).cross(f);
+    c_t[cj] -= (pc.point - c_x[cj]).cross(f);
+    const ResolvedContact& lw = law(types[c_type[ci]].material, types[c_type[cj]].material);
+    if (lw.rolling) {
+      add_roll(ci, pc.out.torque_i, lw);
+      add_roll(cj, pc.out.torque_j, lw);
+    }
+    elastic += pc.out.elastic_energy;
+  }
+  for (int s = 0; s < ns; ++s)
+    for (int k = 0; k < wall_contact_n[s]; ++k) {
+      const WallContactData& wc = wall_contacts[s][k];
+      WallData& wd = walls[wc.wall];
+      const int c = s_clump[s];
+      const Eigen::Vector3d& f = wc.out.force;
+      c_f[c] += f;
+      c_t[c] += (wc.point - c_x[c]).cross(f);
+      const ResolvedContact& lw = law(types[c_type[c]].material, wd.material);
+      if (lw.rolling) add_roll(c, wc.out.torque_i, lw);
+      wd.state.force -= f;
+      wd.state.torque -= (wc.point - wd.state.torque_reference).cross(f);
+      elastic += wc.out.elastic_energy;
+      wall_work += f.dot(wd.state.pose.velocity_at(wc.point)) * hdt;
+    }
+}
+
+void World::Impl::check_health() {
+  auto fail = [&](const std::string& what) {
+    throw NumericalError("step " + std::to_string(steps) + ", t = " + fmt_g(time) +
+                         " s: " + what + " (time step " + fmt_g(dt) + " s)");
+  };
+  if (max_overlap_ratio > 0.5)
+    fail("overlap of " + fmt_g(100.0 * max_overlap_ratio) + " % of a sphere radius between " +
+         max_overlap_what +
+         ": spheres are passing through each other or a wall (time step too large, wall too "
+         "fast, or too soft a material)");
+  if (steps % settings.check_interval != 0) return;
+  const int nc = static_cast<int>(c_x.size());
+  for (int c = 0; c < nc; ++c) {
+    if (!c_x[c].allFinite() || !c_v[c].allFinite() || !c_wb[c].allFinite())
+      fail("clump " + std::to_string(c) + " has a non-finite position or velocity: the run blew up");
+    if (c_v[c].norm() > settings.max_speed)
+      fail("clump " + std::to_string(c) + " moves at " + fmt_g(c_v[c].norm()) +
+           " m/s, above max_speed " + fmt_g(settings.max_speed) + " m/s: the run blew up");
+  }
+  const double ke = kinetic_energy();
+  const double e = ke + potential_energy() + elastic;
+  const double excess = e - (check_energy + wall_work + inserted_energy);
+  double floor = 1e-12;
+  for (int c = 0; c < nc; ++c) floor += types[c_type[c]].mass * settings.gravity.norm() * r_min;
+  const double scale =
+      check_ke + check_elastic + std::abs(wall_work) + std::abs(inserted_energy) + floor;
+  if (excess > scale)
+    fail("energy jumped by " + fmt_g(excess) + " J in " + std::to_string(settings.check_interval) +
+         " steps with no source (kinetic " + fmt_g(check_ke) + " -> " + fmt_g(ke) +
+         " J): the contact forces are unstable");
+  check_energy = e;
+  check_ke = ke;
+  check_elastic = elastic;
+  wall_work = inserted_energy = 0.0;
+}
+
+}  // namespace clumpkit::dem

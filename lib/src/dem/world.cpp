@@ -1,0 +1,522 @@
+// World creation (validation once), accessors, energies and the state hash.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <omp.h>
+
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/dem/time_step.hpp"
+#include "dem/world_impl.hpp"
+
+namespace clumpkit::dem {
+
+namespace {
+
+std::string fmt_g(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+// Moves a template into its centroid-principal frame (as a safety net: templates from
+// make_clump_template already are) and returns the shared type data.
+TypeData make_type(const ClumpTypeSettings& t, const std::string& where, const std::string& f) {
+  validate_spheres(t.clump.spheres, where + ": " + f + ".clump");
+  const MassProperties& mp = t.clump.mass;
+  if (!(mp.mass > 0.0) || !std::isfinite(mp.mass))
+    throw InputError(where, f + ".clump.mass", "the clump mass must be > 0 (got " +
+                                                   fmt_g(mp.mass) + " kg)");
+  Eigen::Matrix3d inertia = mp.inertia_tensor;
+  if (inertia.isZero(0.0)) inertia = mp.principal_moments.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (inertia + inertia.transpose()));
+  Eigen::Vector3d moments = eig.eigenvalues();
+  Eigen::Matrix3d axes = eig.eigenvectors();
+  // Keep the template's own axes when it is already diagonal (the common case): no needless
+  // rotation of a symmetric template.
+  const double off = (inertia - Eigen::Matrix3d(inertia.diagonal().asDiagonal())).norm();
+  if (off <= 1e-12 * inertia.norm()) {
+    moments = inertia.diagonal();
+    axes.setIdentity();
+  } else if (axes.determinant() < 0) {
+    axes.col(2) *= -1.0;
+  }
+  if (!(moments.minCoeff() > 0.0) || !moments.allFinite())
+    throw InputError(where, f + ".clump.mass.inertia_tensor",
+                     "principal moments of inertia must be > 0");
+  TypeData d;
+  d.mass = mp.mass;
+  d.inertia = moments;
+  d.volume = mp.volume;
+  for (const Sphere& s : t.clump.spheres) {
+    d.offsets.push_back(axes.transpose() * (s.center - mp.center_of_mass));
+    d.radii.push_back(s.radius);
+    d.bound_radius = std::max(d.bound_radius, d.offsets.back().norm() + s.radius);
+  }
+  return d;
+}
+
+}  // namespace
+
+World::World(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+World::~World() = default;
+
+World World::create(WorldSettings s) {
+  auto im = std::make_unique<Impl>();
+  Impl& w = *im;
+  const std::string& where = s.source;
+
+  // Materials and the per-pair laws.
+  for (const std::string& name : s.materials.names()) {
+    const Material& m = s.materials.get(name);
+    if (!(m.density > 0.0) || !std::isfinite(m.density))
+      throw InputError(where, "materials." + name + ".density",
+                       "density must be > 0 (got " + fmt_g(m.density) + " kg/m^3)");
+    if (!(m.youngs_modulus > 0.0) || !std::isfinite(m.youngs_modulus))
+      throw InputError(where, "materials." + name + ".youngs_modulus",
+                       "stiffness must be > 0 (got " + fmt_g(m.youngs_modulus) + " Pa)");
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
+      throw InputError(where, "materials." + name + ".poisson_ratio",
+                       "Poisson ratio must lie in (-1, 0.5) (got " + fmt_g(m.poisson_ratio) + ")");
+    w.material_index[name] = static_cast<int>(w.materials.size());
+    w.materials.push_back(m);
+  }
+  const size_t nm = w.materials.size();
+  for (size_t k = 0; k < s.pair_contacts.size(); ++k) {
+    const auto& o = s.pair_contacts[k];
+    const std::string f = "pair_contacts[" + std::to_string(k) + "]";
+    s.materials.get(o.material_a, where, f + ".materials");
+    s.materials.get(o.material_b, where, f + ".materials");
+    o.law.validate(where, f);
+  }
+  // Which materials meet: particles with particles and walls; a missing interaction is only an
+  // error for pairs that can touch.
+  std::vector<char> particle_mat(nm, 0), wall_mat(nm, 0);
+
+  // Clump types.
+  if (s.clump_types.empty() && s.factories.empty() && s.walls.empty())
+    throw InputError(where, "clump_types", "no clump types, walls or factories: nothing to run");
+  for (size_t t = 0; t < s.clump_types.size(); ++t) {
+    const std::string f = "clump_types[" + std::to_string(t) + "]";
+    const auto& ct = s.clump_types[t];
+    if (ct.name.empty()) throw InputError(where, f + ".name", "a clump type needs a name");
+    for (size_t u = 0; u < t; ++u)
+      if (s.clump_types[u].name == ct.name)
+        throw InputError(where, f + ".name", "duplicate clump type '" + ct.name + "'");
+    TypeData d = make_type(ct, where, f);
+    s.materials.get(ct.material, where, f + ".material");
+    d.material = w.material_index.at(ct.material);
+    particle_mat[d.material] = 1;
+    w.types.push_back(std::move(d));
+  }
+
+  // Walls.
+  for (size_t k = 0; k < s.walls.size(); ++k) {
+    const std::string f = "walls[" + std::to_string(k) + "]";
+    const WallSettings& ws = s.walls[k];
+    ws.mesh.validate(where, f + ".mesh");
+    ws.motion.translation.validate(where, f + ".motion.translation");
+    if (ws.motion.rotation) {
+      const WallRotation& r = *ws.motion.rotation;
+      if (!r.axis_point.allFinite() || !std::isfinite(r.rpm) || !std::isfinite(r.start_time))
+        throw InputError(where, f + ".motion.rotation", "values must be finite");
+      if (!(r.axis.norm() > 0.0))
+        throw InputError(where, f + ".motion.rotation.axis", "the axis must not be zero");
+      if (!(r.stop_time >= r.start_time))
+        throw InputError(where, f + ".motion.rotation.stop_time", "stops before it starts");
+    }
+    for (size_t u = 0; u < k; ++u)
+      if (s.walls[u].name == ws.name)
+        throw InputError(where, f + ".name", "duplicate wall name '" + ws.name + "'");
+    s.materials.get(ws.material, where, f + ".material");
+    WallData wd;
+    wd.name = ws.name;
+    wd.material = w.material_index.at(ws.material);
+    wall_mat[wd.material] = 1;
+    wd.ref_vertices = ws.mesh.vertices;
+    wd.triangles = ws.mesh.triangles;
+    wd.motion = ws.motion;
+    if (ws.torque_reference)
+      wd.torque_reference0 = *ws.torque_reference;
+    else if (ws.motion.rotation)
+      wd.torque_reference0 = ws.motion.rotation->axis_point;
+    w.walls.push_back(std::move(wd));
+  }
+
+  // Resolve every pair law that can be used; unknown interactions are input errors.
+  w.laws.resize(nm * nm);
+  const auto names = s.materials.names();
+  for (size_t a = 0; a < nm; ++a)
+    for (size_t b = 0; b < nm; ++b) {
+      const bool used = (particle_mat[a] && (particle_mat[b] || wall_mat[b])) ||
+                        (particle_mat[b] && wall_mat[a]);
+      const Material& ma = w.materials[a];
+      const Material& mb = w.materials[b];
+      const PairContactOverride* over = nullptr;
+      for (const auto& o : s.pair_contacts)
+        if ((o.material_a == ma.name && o.material_b == mb.name) ||
+            (o.material_a == mb.name && o.material_b == ma.name))
+          over = &o;
+      PairContact law;
+      if (over) {
+        law = over->law;
+      } else if (s.materials.has_interaction(ma.name, mb.name)) {
+        law = PairContact::from(s.materials.interaction(ma.name, mb.name), s.rolling_model);
+        law.validate(where, "interactions(" + ma.name + ", " + mb.name + ")");
+      } else if (used) {
+        s.materials.interaction(ma.name, mb.name, where);  // throws the library's message
+      }
+      w.laws[a * nm + b] = resolve(ma, mb, law);
+    }
+
+  // Factories.
+  for (size_t k = 0; k < s.factories.size(); ++k) {
+    const std::string f = "factories[" + std::to_string(k) + "]";
+    const FactorySettings& fs = s.factories[k];
+    FactoryRuntime fr;
+    fr.s = fs;
+    if (fs.count.has_value() == fs.mass.has_value())
+      throw InputError(where, f, "give exactly one of count and mass");
+    if (fs.count && *fs.count < 0) throw InputError(where, f + ".count", "must be >= 0");
+    if (fs.mass && !(*fs.mass >= 0.0 && std::isfinite(*fs.mass)))
+      throw InputError(where, f + ".mass", "must be >= 0 kg");
+    if (!(fs.rate >= 0.0) || !std::isfinite(fs.rate))
+      throw InputError(where, f + ".rate", "must be >= 0");
+    if (!(fs.interval >= 0.0)) throw InputError(where, f + ".interval", "must be >= 0 s");
+    if (fs.attempts_per_clump < 1)
+      throw InputError(where, f + ".attempts_per_clump", "must be >= 1");
+    if (fs.mixture.empty()) throw InputError(where, f + ".mixture", "no clump types given");
+    double total = 0.0;
+    for (size_t e = 0; e < fs.mixture.size(); ++e) {
+      const auto& me = fs.mixture[e];
+      int t = -1;
+      for (size_t u = 0; u < s.clump_types.size(); ++u)
+        if (s.clump_types[u].name == me.clump_type) t = static_cast<int>(u);
+      if (t < 0)
+        throw InputError(where, f + ".mixture[" + std::to_string(e) + "].clump_type",
+                         "unknown clump type '" + me.clump_type + "'");
+      if (!(me.mass_fraction > 0.0) || !std::isfinite(me.mass_fraction))
+        throw InputError(where, f + ".mixture[" + std::to_string(e) + "].mass_fraction",
+                         "must be > 0");
+      fr.types.push_back(t);
+      fr.fractions.push_back(me.mass_fraction);
+      total += me.mass_fraction;
+    }
+    for (double& x : fr.fractions) x /= total;
+    fr.type_mass.assign(fr.types.size(), 0.0);
+    // Region sanity: it must hold the largest clump of the mixture at all.
+    double bound = 0.0;
+    for (int t : fr.types) bound = std::max(bound, w.types[t].bound_radius);
+    bool fits = true;
+    if (const auto* b = std::get_if<BoxRegion>(&fs.region)) {
+      if (!b->min.allFinite() || !b->max.allFinite() || !((b->max - b->min).minCoeff() > 0.0))
+        throw InputError(where, f + ".region", "box min must be below max on every axis");
+      fits = (b->max - b->min).minCoeff() >= 2.0 * bound;
+    } else {
+      const auto& c = std::get<CylinderRegion>(fs.region);
+      if (!(c.radius > 0.0) || !(c.height > 0.0) || !c.base_center.allFinite())
+        throw InputError(where, f + ".region", "cylinder radius and height must be > 0");
+      fits = c.radius >= bound && c.height >= 2.0 * bound;
+    }
+    if (!fits)
+      throw InputError(where, f + ".region",
+                       "the region (" + describe(fs.region) +
+                           ") is smaller than a clump of the mixture (bounding radius " +
+                           fmt_g(bound * 1e3) + " mm)");
+    fr.rng.seed(s.seed + 0x9E3779B97F4A7C15ull * (k + 1));
+    w.factories.push_back(std::move(fr));
+  }
+
+  // Sizes, skin and the time step.
+  w.r_min = std::numeric_limits<double>::infinity();
+  w.r_max = 0.0;
+  int smallest_type = -1;
+  size_t smallest_sphere = 0;
+  for (size_t t = 0; t < w.types.size(); ++t)
+    for (size_t k = 0; k < w.types[t].radii.size(); ++k) {
+      const double r = w.types[t].radii[k];
+      if (r < w.r_min) {
+        w.r_min = r;
+        smallest_type = static_cast<int>(t);
+        smallest_sphere = k;
+      }
+      w.r_max = std::max(w.r_max, r);
+    }
+  (void)smallest_sphere;
+  if (!(s.skin >= 0.0)) throw InputError(where, "skin", "must be >= 0 m");
+  if (!(s.rayleigh_fraction > 0.0))
+    throw InputError(where, "rayleigh_fraction", "must be > 0");
+  if (!(s.time_step >= 0.0) || !std::isfinite(s.time_step))
+    throw InputError(where, "time_step", "must be > 0 s (or 0 for the default)");
+  if (!(s.max_impact_speed > 0.0))
+    throw InputError(where, "max_impact_speed", "must be > 0 m/s");
+  if (!(s.max_speed > 0.0)) throw InputError(where, "max_speed", "must be > 0 m/s");
+  if (s.check_interval < 1) throw InputError(where, "check_interval", "must be >= 1");
+  if (!s.gravity.allFinite()) throw InputError(where, "gravity", "must be finite");
+  if (smallest_type >= 0) {
+    const Material& m = w.materials[w.types[smallest_type].material];
+    const double tr = rayleigh_time(w.r_min, m.density, m.shear_modulus(), m.poisson_ratio);
+    w.dt = s.time_step > 0.0 ? s.time_step : s.rayleigh_fraction * tr;
+    const double frac = w.dt / tr;
+    if (frac > 0.4)
+      w.warnings.push_back("time step " + fmt_g(w.dt) + " s is " + fmt_g(100.0 * frac) +
+                           " % of the Rayleigh time " + fmt_g(tr) +
+                           " s of the smallest sphere (above 40 %: expect instability)");
+    // Hertz contact time at the largest expected impact speed, for every pair that can touch.
+    double tc_min = std::numeric_limits<double>::infinity();
+    std::string tc_what;
+    for (size_t t = 0; t < w.types.size(); ++t)
+      for (double r : w.types[t].radii) {
+        for (size_t u = 0; u < w.types.size(); ++u) {
+          const auto& law = w.law(w.types[t].material, w.types[u].material);
+          const double mst =
+              w.types[t].mass * w.types[u].mass / (w.types[t].mass + w.types[u].mass);
+          for (double r2 : w.types[u].radii) {
+            const double tc =
+                hertz_contact_time(law.e_star, r * r2 / (r + r2), mst, s.max_impact_speed);
+            if (tc < tc_min) tc_min = tc, tc_what = "clump-clump";
+          }
+        }
+        for (const auto& wd : w.walls) {
+          const auto& law = w.law(w.types[t].material, wd.material);
+          const double tc = hertz_contact_time(law.e_star, r, w.types[t].mass, s.max_impact_speed);
+          if (tc < tc_min) tc_min = tc, tc_what = "clump-wall '" + wd.name + "'";
+        }
+      }
+    const double per = tc_min / w.dt;
+    if (per < 5.0)
+      throw InputError(where, "time_step",
+                       "time step " + fmt_g(w.dt) + " s is above the stability limit: a " +
+                           tc_what + " impact at " + fmt_g(s.max_impact_speed) + " m/s lasts " +
+                           fmt_g(tc_min) + " s, only " + fmt_g(per) +
+                           " steps (at least 5 needed, 20 advised)");
+    if (per < 20.0)
+      w.warnings.push_back("a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) +
+                           " m/s lasts only " + fmt_g(per) + " steps (20 or more advised)");
+    w.skin = s.skin > 0.0 ? s.skin : 0.3 * w.r_min;
+    w.cell = 2.0 * w.r_max + w.skin;
+  } else {
+    w.dt = s.time_step > 0.0 ? s.time_step : 1e-5;
+    w.skin = s.skin > 0.0 ? s.skin : 1e-3;
+    w.cell = w.skin;
+    w.r_min = w.r_max = 0.0;
+  }
+  w.threads = s.threads > 0 ? s.threads : omp_get_max_threads();
+  w.wall_cand_start.assign(1, 0);
+  w.settings = std::move(s);
+  w.move_walls();
+  for (auto& wd : w.walls) wd.vertices_build = wd.vertices;
+  w.fingerprint = w.compute_fingerprint();
+  // At-once factories due at t = 0 run now, so a region too small is reported at creation.
+  w.run_factories();
+  return World(std::move(im));
+}
+
+int World::Impl::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quaterniond& q,
+                           const Eigen::Vector3d& v, const Eigen::Vector3d& w_world) {
+  const TypeData& t = types[type];
+  const int c = static_cast<int>(c_x.size());
+  const Eigen::Quaterniond qn = q.normalized();
+  c_type.push_back(type);
+  c_first.push_back(static_cast<int>(s_r.size()));
+  c_x.push_back(x);
+  c_v.push_back(v);
+  c_q.push_back(qn);
+  c_R.push_back(qn.toRotationMatrix());
+  c_wb.push_back(c_R.back().transpose() * w_world);
+  c_f.push_back(Eigen::Vector3d::Zero());
+  c_t.push_back(Eigen::Vector3d::Zero());
+  c_troll.push_back(Eigen::Vector3d::Zero());
+  for (size_t k = 0; k < t.radii.size(); ++k) {
+    s_clump.push_back(c);
+    s_r.push_back(t.radii[k]);
+    s_off.push_back(t.offsets[k]);
+    const Eigen::Vector3d p = x + c_R.back() * t.offsets[k];
+    s_pos.push_back(p);
+    s_pos_build.push_back(p);
+    wall_slots.emplace_back();
+    wall_contacts.emplace_back();
+    wall_contact_n.push_back(0);
+    wall_cand_start.push_back(wall_cand_start.back());
+  }
+  need_rebuild = true;
+  return c;
+}
+
+int World::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quaterniond& q,
+                     const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+  if (type < 0 || type >= clump_type_count())
+    throw InputError(impl_->settings.source, "clump type", "index out of range");
+  if (!x.allFinite() || !v.allFinite() || !w.allFinite() || !q.coeffs().allFinite())
+    throw InputError(impl_->settings.source, "clump state", "non-finite value");
+  return impl_->add_clump(type, x, q, v, w);
+}
+
+double World::Impl::kinetic_energy() const {
+  double e = 0.0;
+  for (size_t c = 0; c < c_x.size(); ++c) {
+    const TypeData& t = types[c_type[c]];
+    e += 0.5 * t.mass * c_v[c].squaredNorm() +
+         0.5 * c_wb[c].dot(t.inertia.cwiseProduct(c_wb[c]));
+  }
+  return e;
+}
+
+double World::Impl::potential_energy() const {
+  double e = 0.0;
+  for (size_t c = 0; c < c_x.size(); ++c) e -= types[c_type[c]].mass * settings.gravity.dot(c_x[c]);
+  return e;
+}
+
+std::uint64_t World::Impl::compute_fingerprint() const {
+  Hasher h;
+  h.value(dt);
+  h.value(materials.size());
+  for (const auto& t : types) {
+    h.value(t.mass);
+    h.value(t.material);
+    h.vec(t.radii);
+    h.vec(t.offsets);
+  }
+  for (const auto& wd : walls) {
+    h.value(wd.material);
+    h.vec(wd.ref_vertices);
+    h.vec(wd.triangles);
+  }
+  h.value(factories.size());
+  h.value(settings.seed);
+  return h.h;
+}
+
+// Accessors.
+double World::time() const { return impl_->time; }
+long World::step_count() const { return impl_->steps; }
+double World::dt() const { return impl_->dt; }
+const std::vector<std::string>& World::warnings() const { return impl_->warnings; }
+const Profile& World::profile() const { return impl_->profile; }
+Profile& World::profile() { return impl_->profile; }
+const WorldSettings& World::settings() const { return impl_->settings; }
+int World::clump_type_count() const { return static_cast<int>(impl_->types.size()); }
+int World::clump_type_index(const std::string& name) const {
+  const auto& ct = impl_->settings.clump_types;
+  for (size_t t = 0; t < ct.size(); ++t)
+    if (ct[t].name == name) return static_cast<int>(t);
+  throw InputError(impl_->settings.source, "clump_type", "unknown clump type '" + name + "'");
+}
+const ClumpTypeSettings& World::clump_type(int t) const { return impl_->settings.clump_types[t]; }
+double World::clump_type_mass(int t) const { return impl_->types[t].mass; }
+Eigen::Vector3d World::clump_type_inertia(int t) const { return impl_->types[t].inertia; }
+int World::clump_count() const { return static_cast<int>(impl_->c_x.size()); }
+long World::sphere_count() const { return static_cast<long>(impl_->s_r.size()); }
+int World::clump_type_of(int c) const { return impl_->c_type[c]; }
+double World::clump_mass(int c) const { return impl_->types[impl_->c_type[c]].mass; }
+const std::vector<Eigen::Vector3d>& World::positions() const { return impl_->c_x; }
+const std::vector<Eigen::Quaterniond>& World::orientations() const { return impl_->c_q; }
+const std::vector<Eigen::Vector3d>& World::velocities() const { return impl_->c_v; }
+const std::vector<Eigen::Vector3d>& World::omegas_body() const { return impl_->c_wb; }
+Eigen::Vector3d World::omega_world(int c) const { return impl_->c_R[c] * impl_->c_wb[c]; }
+void World::set_velocity(int c, const Eigen::Vector3d& v) { impl_->c_v[c] = v; }
+void World::set_omega_world(int c, const Eigen::Vector3d& w) {
+  impl_->c_wb[c] = impl_->c_R[c].transpose() * w;
+}
+const std::vector<Eigen::Vector3d>& World::contact_forces() const { return impl_->c_f; }
+const std::vector<Eigen::Vector3d>& World::contact_torques() const { return impl_->c_t; }
+const std::vector<Eigen::Vector3d>& World::sphere_positions() const { return impl_->s_pos; }
+const std::vector<double>& World::sphere_radii() const { return impl_->s_r; }
+const std::vector<int>& World::sphere_clumps() const { return impl_->s_clump; }
+int World::wall_count() const { return static_cast<int>(impl_->walls.size()); }
+int World::wall_index(const std::string& name) const {
+  for (size_t k = 0; k < impl_->walls.size(); ++k)
+    if (impl_->walls[k].name == name) return static_cast<int>(k);
+  throw InputError(impl_->settings.source, "wall", "unknown wall '" + name + "'");
+}
+const WallSettings& World::wall_settings(int w) const { return impl_->settings.walls[w]; }
+const WallState& World::wall(int w) const { return impl_->walls[w].state; }
+const std::vector<Eigen::Vector3d>& World::wall_vertices(int w) const {
+  return impl_->walls[w].vertices;
+}
+int World::factory_count() const { return static_cast<int>(impl_->factories.size()); }
+const FactoryStatus& World::factory_status(int f) const { return impl_->factories[f].status; }
+bool World::factories_done() const {
+  for (const auto& f : impl_->factories)
+    if (!f.status.done) return false;
+  return true;
+}
+double World::kinetic_energy() const { return impl_->kinetic_energy(); }
+double World::potential_energy() const { return impl_->potential_energy(); }
+double World::elastic_energy() const { return impl_->elastic; }
+double World::total_mass() const {
+  double m = 0.0;
+  for (int t : impl_->c_type) m += impl_->types[t].mass;
+  return m;
+}
+int World::contact_count() const {
+  int n = static_cast<int>(impl_->pair_contacts.size());
+  for (int k : impl_->wall_contact_n) n += k;
+  return n;
+}
+
+std::vector<ContactInfo> World::contacts() const {
+  const Impl& w = *impl_;
+  std::vector<ContactInfo> out;
+  for (const auto& pc : w.pair_contacts) {
+    const PairEntry& p = w.pairs[pc.pair];
+    out.push_back({w.s_clump[p.i], w.s_clump[p.j], -1, pc.point, pc.normal, pc.overlap,
+                   pc.out.force});
+  }
+  for (size_t s = 0; s < w.wall_contact_n.size(); ++s)
+    for (int k = 0; k < w.wall_contact_n[s]; ++k) {
+      const auto& wc = w.wall_contacts[s][k];
+      out.push_back({w.s_clump[s], -1, wc.wall, wc.point, wc.normal, wc.overlap, wc.out.force});
+    }
+  return out;
+}
+
+const ResolvedContact& World::resolved_contact(const std::string& a, const std::string& b) const {
+  const auto& idx = impl_->material_index;
+  auto ia = idx.find(a), ib = idx.find(b);
+  if (ia == idx.end() || ib == idx.end())
+    throw InputError(impl_->settings.source, "material", "unknown material '" +
+                                                             (ia == idx.end() ? a : b) + "'");
+  return impl_->law(ia->second, ib->second);
+}
+
+std::uint64_t World::state_hash() const {
+  const Impl& w = *impl_;
+  Hasher h;
+  h.value(w.time);
+  h.value(w.steps);
+  h.vec(w.c_type);
+  h.vec(w.c_x);
+  h.vec(w.c_v);
+  h.vec(w.c_wb);
+  for (const auto& q : w.c_q) h.value(q.coeffs().eval());
+  h.vec(w.c_f);
+  h.vec(w.c_t);
+  for (size_t k = 0; k < w.pairs.size(); ++k)
+    if (!w.pair_hist[k].shear.isZero(0.0) || !w.pair_hist[k].roll.isZero(0.0)) {
+      h.value(w.pairs[k]);
+      h.value(w.pair_hist[k]);
+    }
+  for (const auto& slots : w.wall_slots)
+    for (const auto& sl : slots) {
+      h.value(sl.wall);
+      if (sl.wall >= 0) {
+        h.value(sl.normal);
+        h.value(sl.history);
+      }
+    }
+  for (const auto& wd : w.walls) {
+    h.value(wd.state.force);
+    h.value(wd.state.torque);
+  }
+  for (const auto& f : w.factories) {
+    h.value(f.status.inserted);
+    h.value(f.status.inserted_mass);
+  }
+  return h.h;
+}
+
+}  // namespace clumpkit::dem

@@ -1,0 +1,193 @@
+#pragma once
+// Internal state of dem::World. Hot per-instance data are arrays indexed by clump or sphere;
+// template data are shared per clump type.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "clumpkit/dem/world.hpp"
+
+namespace clumpkit::dem {
+
+/// Template data shared by every clump of one type (principal frame).
+struct TypeData {
+  std::vector<Eigen::Vector3d> offsets;  // sphere centres relative to the centre of mass, m
+  std::vector<double> radii;             // m
+  double mass = 0.0;                     // kg
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // principal moments, kg m^2
+  double bound_radius = 0.0;  // max |offset| + radius, m
+  double volume = 0.0;        // union volume, m^3
+  int material = 0;
+};
+
+struct WallData {
+  std::string name;
+  int material = 0;
+  std::vector<Eigen::Vector3d> ref_vertices;  // at t = 0
+  std::vector<std::array<int, 3>> triangles;
+  WallMotion motion;
+  Eigen::Vector3d torque_reference0 = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> vertices;        // current
+  std::vector<Eigen::Vector3d> vertices_build;  // at the last neighbour rebuild
+  WallState state;
+};
+
+struct PairEntry {
+  int i = 0, j = 0;  // sphere indices, i < j, different clumps
+};
+
+// Geometry of an active sphere-sphere contact (contacts stage) and its result (forces stage).
+struct PairContactData {
+  int pair = 0;
+  Eigen::Vector3d normal, point;
+  double overlap = 0.0;
+  ContactForce out;
+};
+
+inline constexpr int kWallSlots = 4;  // wall contacts kept per sphere
+
+struct WallSlot {
+  int wall = -1;  // −1 = unused
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  ContactHistory history;
+};
+
+struct WallContactData {
+  int wall = -1;
+  Eigen::Vector3d normal, point;
+  double overlap = 0.0;
+  ContactForce out;
+};
+
+struct FactoryRuntime {
+  FactorySettings s;
+  std::vector<int> types;
+  std::vector<double> fractions;          // normalised mass fractions
+  std::vector<double> type_mass;          // kg inserted per mixture entry
+  FactoryStatus status;
+  std::mt19937_64 rng;
+  long batch = 0;        // next batch index
+  double interval = 0.0;  // s
+};
+
+using Clock = std::chrono::steady_clock;
+
+struct World::Impl {
+  WorldSettings settings;
+  double dt = 0.0;
+  double time = 0.0;
+  long steps = 0;
+  int threads = 1;
+  std::vector<std::string> warnings;
+  Profile profile;
+
+  std::vector<Material> materials;
+  std::map<std::string, int> material_index;
+  std::vector<ResolvedContact> laws;  // [a * nm + b]
+  std::vector<TypeData> types;
+
+  // Clumps (structure of arrays).
+  std::vector<int> c_type, c_first;
+  std::vector<Eigen::Vector3d> c_x, c_v, c_wb;  // wb: angular velocity, principal frame
+  std::vector<Eigen::Quaterniond> c_q;          // body → world
+  std::vector<Eigen::Matrix3d> c_R;             // rotation matrix of c_q
+  std::vector<Eigen::Vector3d> c_f, c_t;        // contact force / torque (no rolling), world
+  std::vector<Eigen::Vector3d> c_troll;         // rolling-resistance torque, world
+  std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
+
+  // Sub-spheres.
+  std::vector<int> s_clump;
+  std::vector<double> s_r;
+  std::vector<Eigen::Vector3d> s_off;  // body-frame offset (copied from the type)
+  std::vector<Eigen::Vector3d> s_pos, s_pos_build;
+
+  std::vector<WallData> walls;
+
+  // Neighbour lists: sphere pairs sorted by (i, j) with their histories; per-sphere wall
+  // candidates (wall, triangle) in CSR form; per-sphere wall contact histories.
+  std::vector<PairEntry> pairs;
+  std::vector<ContactHistory> pair_hist;
+  std::vector<int> wall_cand_start;
+  std::vector<std::array<int, 2>> wall_cand;
+  std::vector<std::array<WallSlot, kWallSlots>> wall_slots;
+  bool need_rebuild = true;
+  double skin = 0.0, cell = 0.0, r_max = 0.0, r_min = 0.0;
+
+  // Contacts of the current step.
+  std::vector<PairContactData> pair_contacts;
+  std::vector<std::array<WallContactData, kWallSlots>> wall_contacts;  // per sphere
+  std::vector<int> wall_contact_n;                                     // per sphere
+  bool forces_valid = false;
+  double elastic = 0.0;
+  double max_overlap_ratio = 0.0;
+  std::string max_overlap_what;
+  bool slot_overflow_warned = false;
+
+  std::vector<FactoryRuntime> factories;
+
+  // Energy bookkeeping for blow-up detection.
+  double check_energy = 0.0;  // KE + PE + elastic at the last check
+  double check_ke = 0.0;
+  double check_elastic = 0.0;
+  double wall_work = 0.0;       // J done by walls on particles since the last check
+  double inserted_energy = 0.0;  // J brought in by factories since the last check
+  bool check_initialised = false;
+
+  std::uint64_t fingerprint = 0;
+
+  // Stages (step.cpp).
+  void ensure_forces();
+  void kick_and_drift();
+  void move_walls();
+  void run_factories();
+  void update_neighbours();
+  void detect_contacts();
+  void compute_forces(double history_dt);
+  void kick();
+  void check_health();
+  void update_spheres(int first_clump);
+
+  // Helpers.
+  const ResolvedContact& law(int ma, int mb) const {
+    return laws[static_cast<size_t>(ma) * materials.size() + mb];
+  }
+  int add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quaterniond& q,
+                const Eigen::Vector3d& v, const Eigen::Vector3d& w_world);
+  double kinetic_energy() const;
+  double potential_energy() const;
+  void rebuild_neighbours();
+  std::uint64_t compute_fingerprint() const;
+};
+
+/// FNV-1a over raw bytes.
+struct Hasher {
+  std::uint64_t h = 1469598103934665603ull;
+  void bytes(const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t k = 0; k < n; ++k) {
+      h ^= b[k];
+      h *= 1099511628211ull;
+    }
+  }
+  template <class T>
+  void value(const T& v) {
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    value(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+/// Closest point on triangle (a, b, c) to p.
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+}  // namespace clumpkit::dem
