@@ -56,7 +56,7 @@ void World::Impl::rebuild_neighbours() {
   // Spheres sorted by cell.
   std::vector<std::pair<std::uint64_t, int>> bins(ns);
   std::vector<std::array<std::int64_t, 3>> sc(ns);
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     sc[s] = {cell_of(s_pos[s].x(), h), cell_of(s_pos[s].y(), h), cell_of(s_pos[s].z(), h)};
     bins[s] = {cell_key(sc[s][0], sc[s][1], sc[s][2]), s};
@@ -71,7 +71,7 @@ void World::Impl::rebuild_neighbours() {
 
   // Sphere pairs, per sphere i the sorted list of j > i.
   std::vector<std::vector<int>> near(ns);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
   for (int i = 0; i < ns; ++i) {
     auto& out = near[i];
     for (int dx = -1; dx <= 1; ++dx)
@@ -125,7 +125,7 @@ void World::Impl::rebuild_neighbours() {
   }
   std::sort(tri_bins.begin(), tri_bins.end());
   std::vector<std::vector<std::array<int, 2>>> cand(ns);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     const std::uint64_t key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
     auto lo = std::lower_bound(tri_bins.begin(), tri_bins.end(),

@@ -84,7 +84,7 @@ void World::Impl::update_spheres(int first_clump) {
   const int n0 = first_clump < static_cast<int>(c_first.size()) ? c_first[first_clump]
                                                                  : static_cast<int>(s_r.size());
   const int ns = static_cast<int>(s_r.size());
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(ns - n0 >= kParallelMin)
   for (int s = n0; s < ns; ++s) {
     const int c = s_clump[s];
     s_pos[s] = c_x[c] + c_R[c] * s_off[s];
@@ -114,7 +114,7 @@ static inline void half_kick(World::Impl& w, int c, double h) {
 void World::Impl::kick_and_drift() {
   const int nc = static_cast<int>(c_x.size());
   const double h = 0.5 * dt;
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(nc >= kParallelMin)
   for (int c = 0; c < nc; ++c) {
     half_kick(*this, c, h);
     c_x[c] += dt * c_v[c];
@@ -142,7 +142,7 @@ void World::Impl::kick_and_drift() {
 void World::Impl::kick() {
   const int nc = static_cast<int>(c_x.size());
   const double h = 0.5 * dt;
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(nc >= kParallelMin)
   for (int c = 0; c < nc; ++c) half_kick(*this, c, h);
 }
 
@@ -160,7 +160,7 @@ void World::Impl::move_walls() {
 void World::Impl::update_neighbours() {
   const int ns = static_cast<int>(s_r.size());
   double ds = 0.0;
-#pragma omp parallel for num_threads(threads) schedule(static) reduction(max : ds)
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(max : ds) if(ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
   ds = std::sqrt(ds);
   double dw = 0.0;
@@ -178,7 +178,7 @@ void World::Impl::detect_contacts() {
   // Sphere pairs: flag in parallel, compact in order.
   const int np = static_cast<int>(pairs.size());
   std::vector<double> dist(np);
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(np >= kParallelMin)
   for (int k = 0; k < np; ++k) {
     const PairEntry& p = pairs[k];
     const double rr = s_r[p.i] + s_r[p.j];
@@ -220,7 +220,7 @@ void World::Impl::detect_contacts() {
   const double merge_cos = std::cos(10.0 * 3.14159265358979323846 / 180.0);
   std::vector<double> ratio_s(ns, 0.0);
   std::vector<int> overflow(ns, 0);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     struct Cand {
       double dist;
@@ -319,11 +319,11 @@ void World::Impl::detect_contacts() {
 void World::Impl::compute_forces(double hdt) {
   const int nc = static_cast<int>(c_x.size());
   c_ww.resize(nc);
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(nc >= kParallelMin)
   for (int c = 0; c < nc; ++c) c_ww[c] = c_R[c] * c_wb[c];
 
   const int npc = static_cast<int>(pair_contacts.size());
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(static) if(npc >= kParallelMin)
   for (int k = 0; k < npc; ++k) {
     PairContactData& pc = pair_contacts[k];
     const PairEntry& p = pairs[pc.pair];
@@ -345,7 +345,7 @@ void World::Impl::compute_forces(double hdt) {
   }
 
   const int ns = static_cast<int>(s_r.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 256)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if(ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     const int n = wall_contact_n[s];
     if (n == 0) continue;

@@ -51,6 +51,9 @@ struct PairContactData {
 };
 
 inline constexpr int kWallSlots = 4;  // wall contacts kept per sphere
+// Loops shorter than this run on one thread: a parallel region costs more than it saves, and a
+// lot more on a loaded machine. Results do not depend on it (see determinism tests).
+inline constexpr int kParallelMin = 512;
 
 struct WallSlot {
   int wall = -1;  // −1 = unused
