@@ -1,2 +1,176 @@
+// Sphere–triangle contacts: one contact per flat region however it is triangulated, correct
+// multi-contacts in concave corners, wall loads and prescribed motions.
 #include <gtest/gtest.h>
-TEST(Walls, Placeholder) {}
+
+#include <cmath>
+
+#include "clumpkit/core/error.hpp"
+#include "scenes.hpp"
+
+namespace clumpkit::dem {
+namespace {
+
+struct Resting {
+  int contacts = 0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+};
+
+// A sphere pressed into a floor (overlap 1 µm) at (x, y); one step, no gravity.
+Resting press(int divisions, double x, double y) {
+  WorldSettings s;
+  s.gravity.setZero();
+  s.materials = test::test_materials(0.5, 0.5, 0.05);
+  const double r = 2e-3;
+  s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+  s.walls.push_back(test::floor_wall(0.04, divisions));
+  World w = World::create(s);
+  w.add_clump(0, Eigen::Vector3d(x, y, r - 1e-6));
+  w.step();
+  return {w.contact_count(), w.contact_forces()[0]};
+}
+
+TEST(Walls, OneContactOnAFlatFaceSplitIntoManyTriangles) {
+  const Resting coarse = press(1, 1e-3, 2e-3);
+  ASSERT_EQ(coarse.contacts, 1);
+  ASSERT_GT(coarse.force.z(), 0.0);
+  // 16 × 16 squares of 2.5 mm: on a vertex shared by six triangles, on an edge shared by two
+  // coplanar triangles, on a diagonal, inside a triangle.
+  const double d = 0.04 / 16;
+  for (auto [x, y] : {std::pair{0.0, 0.0}, std::pair{d, 0.5 * d}, std::pair{0.5 * d, 0.0},
+                      std::pair{0.5 * d, 0.5 * d}, std::pair{0.3 * d, 0.7 * d}}) {
+    const Resting fine = press(16, x, y);
+    EXPECT_EQ(fine.contacts, 1) << x << ", " << y;
+    EXPECT_NEAR((fine.force - coarse.force).norm(), 0.0, 1e-9 * coarse.force.norm());
+  }
+}
+
+TEST(Walls, RollingAcrossManyTrianglesFeelsOneSmoothContact) {
+  auto roll = [](int divisions) {
+    WorldSettings s;
+    s.materials = test::test_materials(0.3, 0.5, 0.05);
+    const double r = 2e-3;
+    s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+    s.walls.push_back(test::floor_wall(0.2, divisions));
+    World w = World::create(s);
+    w.add_clump(0, Eigen::Vector3d(-0.01, 0.003, r), Eigen::Quaterniond::Identity(),
+                Eigen::Vector3d(0.3, 0.1, 0), Eigen::Vector3d(-0.1 / r, 0.3 / r, 0));
+    int max_contacts = 0;
+    while (w.time() < 0.05) {
+      w.step();
+      max_contacts = std::max(max_contacts, w.contact_count());
+    }
+    EXPECT_EQ(max_contacts, 1);
+    return w.positions()[0];
+  };
+  const Eigen::Vector3d a = roll(1), b = roll(40);
+  EXPECT_NEAR((a - b).norm(), 0.0, 1e-9);
+}
+
+TEST(Walls, ConvexEdgeGivesOneContactConcaveCornerGivesThree) {
+  WorldSettings s;
+  s.gravity.setZero();
+  s.materials = test::test_materials(0.5, 0.5, 0.05);
+  const double r = 2e-3;
+  s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+  WallSettings block{"block", make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.01, 0.01, 0.01)),
+                     "galvanized_steel", {}, {}};
+  s.walls.push_back(block);
+  World w = World::create(s);
+  // Outside, over the top corner vertex (0, 0, 0.01), touching it diagonally.
+  const Eigen::Vector3d dir = Eigen::Vector3d(-1, -1, 1).normalized();
+  w.add_clump(0, Eigen::Vector3d(0, 0, 0.01) + (r - 1e-6) * dir);
+  // Outside, over the middle of the top edge y = 0, z = 0.01.
+  const Eigen::Vector3d dir2 = Eigen::Vector3d(0, -1, 1).normalized();
+  w.add_clump(0, Eigen::Vector3d(0.005, 0, 0.01) + (r - 1e-6) * dir2);
+  w.step();
+  EXPECT_EQ(w.contact_count(), 2);
+  const auto c = w.contacts();
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_NEAR(c[0].normal.dot(dir), 1.0, 1e-9);
+  EXPECT_NEAR(c[1].normal.dot(dir2), 1.0, 1e-9);
+
+  // Inside a closed box, in a corner: floor and two side walls.
+  WorldSettings s2 = s;
+  s2.walls = {{"box", make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.02, 0.02, 0.02)),
+               "galvanized_steel", {}, {}}};
+  World w2 = World::create(s2);
+  w2.add_clump(0, Eigen::Vector3d(r - 1e-6, r - 1e-6, r - 1e-6));
+  w2.step();
+  EXPECT_EQ(w2.contact_count(), 3);
+}
+
+TEST(Walls, WallRecordsForceAndTorque) {
+  WorldSettings s;
+  s.materials = test::test_materials(0.2, 0.5, 0.05);
+  const double r = 2e-3;
+  s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+  s.walls.push_back(test::floor_wall(0.1, 4));
+  World w = World::create(s);
+  w.add_clump(0, Eigen::Vector3d(0.01, -0.02, r));
+  w.run_until(0.1);
+  const double mg = w.clump_mass(0) * 9.81;
+  const WallState& ws = w.wall(0);
+  EXPECT_NEAR(ws.force.z(), -mg, 1e-4 * mg);
+  EXPECT_NEAR(ws.force.head<2>().norm(), 0.0, 1e-6 * mg);
+  // Torque about the origin of the weight carried at (0.01, −0.02): r × F.
+  const Eigen::Vector3d expected = Eigen::Vector3d(0.01, -0.02, 0).cross(Eigen::Vector3d(0, 0, -mg));
+  EXPECT_NEAR((ws.torque - expected).norm(), 0.0, 1e-4 * expected.norm());
+}
+
+TEST(Walls, MotionKinematics) {
+  VelocityProfile p{{0.0, 1.0, 2.0},
+                    {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, 2)}};
+  EXPECT_NEAR(p.displacement(1.0).z(), 1.0, 1e-15);
+  EXPECT_NEAR(p.displacement(0.5).z(), 0.25, 1e-15);
+  EXPECT_NEAR(p.displacement(3.0).z(), 1.0 + 2.0 * 2.0, 1e-14);
+  WallMotion m;
+  m.translation = VelocityProfile::constant(Eigen::Vector3d(0.1, 0, 0));
+  m.rotation = WallRotation{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 0, 1), 30.0, 0.5};
+  const WallPose a = wall_pose(m, 0.25), b = wall_pose(m, 1.5);
+  EXPECT_TRUE(a.rotation.isIdentity(0.0));
+  EXPECT_NEAR(b.omega.z(), std::numbers::pi, 1e-12);  // 30 rpm
+  // Velocity of a material point = finite difference of its position.
+  const Eigen::Vector3d x0(0.2, 0.1, 0.3);
+  const double h = 1e-6;
+  const Eigen::Vector3d fd =
+      (wall_pose(m, 1.5 + h).apply(x0) - wall_pose(m, 1.5 - h).apply(x0)) / (2 * h);
+  EXPECT_NEAR((fd - b.velocity_at(b.apply(x0))).norm(), 0.0, 1e-6);
+}
+
+TEST(Walls, LiftingPistonCarriesASphere) {
+  WorldSettings s;
+  s.materials = test::test_materials(0.2, 0.5, 0.05);
+  const double r = 2e-3;
+  s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+  WallSettings piston = test::floor_wall(0.05, 2);
+  piston.motion.translation = {{0.1, 0.2}, {Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.05)}};
+  s.walls.push_back(piston);
+  World w = World::create(s);
+  w.add_clump(0, Eigen::Vector3d(0, 0, r));
+  w.run_until(0.4);
+  EXPECT_NEAR(w.velocities()[0].z(), 0.05, 1e-3);
+  // The wall moved 0.0025 + 0.01 m by t = 0.4 s; the sphere rides on it.
+  EXPECT_NEAR(w.positions()[0].z(), r + 0.0125, 2e-5);
+}
+
+TEST(Walls, BadMeshIsAnInputError) {
+  WorldSettings s;
+  s.source = "scene.toml";
+  s.clump_types.push_back(test::sphere_type("ball", 2e-3, 1380.0));
+  WallSettings bad{"cup", {}, "organic_glass", {}, {}};
+  bad.mesh.vertices = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2, 0, 0)};
+  bad.mesh.triangles = {{0, 1, 2}};
+  s.walls.push_back(bad);
+  try {
+    (void)World::create(s);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "scene.toml");
+    EXPECT_EQ(e.field(), "walls[0].mesh.triangles[0]");
+  }
+  s.walls[0] = test::floor_wall(0.1, 1, 0.0, "unobtainium");
+  EXPECT_THROW((void)World::create(s), InputError);
+}
+
+}  // namespace
+}  // namespace clumpkit::dem

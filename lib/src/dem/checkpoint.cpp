@@ -77,7 +77,7 @@ void World::save_checkpoint(const std::filesystem::path& path) const {
   o.vec(w.c_q);
   o.vec(w.c_f);
   o.vec(w.c_t);
-  o.vec(w.c_troll);
+  o.vec(w.c_mroll);
   o.vec(w.s_pos_build);
   o.vec(w.pairs);
   o.vec(w.pair_hist);
@@ -138,7 +138,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   w.c_wb.clear();
   w.c_f.clear();
   w.c_t.clear();
-  w.c_troll.clear();
+  w.c_mroll.clear();
   w.s_clump.clear();
   w.s_r.clear();
   w.s_off.clear();
@@ -160,7 +160,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   in.vec(w.c_q);
   in.vec(w.c_f);
   in.vec(w.c_t);
-  in.vec(w.c_troll);
+  in.vec(w.c_mroll);
   in.vec(w.s_pos_build);
   in.vec(w.pairs);
   in.vec(w.pair_hist);

@@ -118,6 +118,7 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   out.elastic_energy = 0.4 * f_hertz * delta;
   out.torque_i.setZero();
   out.torque_j.setZero();
+  out.roll_i = out.roll_j = 0.0;
 
   // Tangential: Mindlin no-slip history spring with damping, capped at μs |Fn|, eq. (4).
   if (law.friction) {
@@ -147,10 +148,8 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   switch (law.roll.model) {
     case RollingModel::kStandard: {
       const double mag = mu_r * std::abs(fn_contact);
-      const double wi = k.omega_i.norm();
-      if (wi > 0.0) out.torque_i = -(mag * k.radius_i / wi) * k.omega_i;
-      const double wj = k.omega_j.norm();
-      if (k.radius_j > 0.0 && wj > 0.0) out.torque_j = -(mag * k.radius_j / wj) * k.omega_j;
+      out.roll_i = mag * k.radius_i;
+      out.roll_j = mag * k.radius_j;  // 0 against a wall
       break;
     }
     case RollingModel::kCdt: {

@@ -98,12 +98,14 @@ static inline void half_kick(World::Impl& w, int c, double h) {
   w.c_v[c] += h * (w.c_f[c] / t.mass + w.settings.gravity);
   Eigen::Vector3d pi = t.inertia.cwiseProduct(w.c_wb[c]);
   pi += h * (w.c_R[c].transpose() * w.c_t[c]);
-  if (!w.c_troll[c].isZero(0.0)) {
-    Eigen::Vector3d dpi = h * (w.c_R[c].transpose() * w.c_troll[c]);
+  if (w.c_mroll[c] > 0.0) {
+    // −M ω̂ with ω̂ the direction of rotation now, at most enough to stop the rotation.
     const Eigen::Vector3d w0 = pi.cwiseQuotient(t.inertia);
     const double wn = w0.norm();
     if (wn > 0.0) {
-      const double along = -dpi.cwiseQuotient(t.inertia).dot(w0) / wn;
+      const Eigen::Vector3d dir = w0 / wn;
+      Eigen::Vector3d dpi = -(h * w.c_mroll[c]) * dir;
+      const double along = -dpi.cwiseQuotient(t.inertia).dot(dir);
       if (along > wn) dpi *= wn / along;
       pi += dpi;
     }
@@ -373,18 +375,16 @@ void World::Impl::compute_forces(double hdt) {
   for (int c = 0; c < nc; ++c) {
     c_f[c].setZero();
     c_t[c].setZero();
-    c_troll[c].setZero();
+    c_mroll[c] = 0.0;
   }
   for (WallData& wd : walls) {
     wd.state.force.setZero();
     wd.state.torque.setZero();
   }
   elastic = 0.0;
-  auto add_roll = [&](int c, const Eigen::Vector3d& tq, const ResolvedContact& lw) {
-    if (lw.roll.model == RollingModel::kStandard)
-      c_troll[c] += tq;
-    else
-      c_t[c] += tq;
+  auto add_roll = [&](int c, const Eigen::Vector3d& tq, double m) {
+    c_t[c] += tq;
+    c_mroll[c] += m;
   };
   for (const PairContactData& pc : pair_contacts) {
     const PairEntry& p = pairs[pc.pair];
@@ -396,8 +396,8 @@ void World::Impl::compute_forces(double hdt) {
     c_t[cj] -= (pc.point - c_x[cj]).cross(f);
     const ResolvedContact& lw = law(types[c_type[ci]].material, types[c_type[cj]].material);
     if (lw.rolling) {
-      add_roll(ci, pc.out.torque_i, lw);
-      add_roll(cj, pc.out.torque_j, lw);
+      add_roll(ci, pc.out.torque_i, pc.out.roll_i);
+      add_roll(cj, pc.out.torque_j, pc.out.roll_j);
     }
     elastic += pc.out.elastic_energy;
   }
@@ -410,7 +410,7 @@ void World::Impl::compute_forces(double hdt) {
       c_f[c] += f;
       c_t[c] += (wc.point - c_x[c]).cross(f);
       const ResolvedContact& lw = law(types[c_type[c]].material, wd.material);
-      if (lw.rolling) add_roll(c, wc.out.torque_i, lw);
+      if (lw.rolling) add_roll(c, wc.out.torque_i, wc.out.roll_i);
       wd.state.force -= f;
       wd.state.torque -= (wc.point - wd.state.torque_reference).cross(f);
       elastic += wc.out.elastic_energy;

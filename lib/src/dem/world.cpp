@@ -328,7 +328,7 @@ int World::Impl::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quat
   c_wb.push_back(c_R.back().transpose() * w_world);
   c_f.push_back(Eigen::Vector3d::Zero());
   c_t.push_back(Eigen::Vector3d::Zero());
-  c_troll.push_back(Eigen::Vector3d::Zero());
+  c_mroll.push_back(0.0);
   for (size_t k = 0; k < t.radii.size(); ++k) {
     s_clump.push_back(c);
     s_r.push_back(t.radii[k]);
@@ -495,6 +495,7 @@ std::uint64_t World::state_hash() const {
   for (const auto& q : w.c_q) h.value(q.coeffs().eval());
   h.vec(w.c_f);
   h.vec(w.c_t);
+  h.vec(w.c_mroll);
   for (size_t k = 0; k < w.pairs.size(); ++k)
     if (!w.pair_hist[k].shear.isZero(0.0) || !w.pair_hist[k].roll.isZero(0.0)) {
       h.value(w.pairs[k]);

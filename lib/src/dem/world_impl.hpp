@@ -101,7 +101,7 @@ struct World::Impl {
   std::vector<Eigen::Quaterniond> c_q;          // body → world
   std::vector<Eigen::Matrix3d> c_R;             // rotation matrix of c_q
   std::vector<Eigen::Vector3d> c_f, c_t;        // contact force / torque (no rolling), world
-  std::vector<Eigen::Vector3d> c_troll;         // rolling-resistance torque, world
+  std::vector<double> c_mroll;  // standard rolling resistance: Σ μr R |Fn|, N m
   std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
 
   // Sub-spheres.

@@ -92,8 +92,14 @@ struct ContactHistory {
 
 struct ContactForce {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on i (j gets −force), N
-  Eigen::Vector3d torque_i = Eigen::Vector3d::Zero();  ///< rolling torque on clump i, N m
-  Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();  ///< rolling torque on clump j, N m
+  /// Rolling torque on clump i / j (CDT and EPSD models), N m.
+  Eigen::Vector3d torque_i = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();
+  /// Standard model: magnitude μr R |Fn| of the torque that opposes clump i's / j's own
+  /// angular velocity, N m. The integrator applies it along −ω̂ at the moment of the kick (so a
+  /// clump at rest stays at rest), limited so that it stops a rotation but never reverses it.
+  double roll_i = 0.0;
+  double roll_j = 0.0;
   double normal = 0.0;            ///< signed normal force (Hertz + damping + cohesion), N
   double elastic_energy = 0.0;    ///< stored in the normal and tangential springs, J
 };
