@@ -31,7 +31,7 @@ class MeshSolid final : public SurfaceSolid {
   const TriangleMesh& mesh() const { return mesh_; }
   /// Lines whose crossings could not be paired even after retrying (should stay 0 for a valid
   /// mesh); reset by reset_counters().
-  long long unresolved_lines() const { return unresolved_.load(); }
+  long long unresolved_lines() const override { return unresolved_.load(); }
   /// Lines that needed a shifted retry.
   long long retried_lines() const { return retried_.load(); }
   void reset_counters() const;

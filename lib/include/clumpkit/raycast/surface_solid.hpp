@@ -15,6 +15,9 @@ class SurfaceSolid : public RaySolid {
   virtual double surface_distance(const Eigen::Vector3d& p) const = 0;
   /// `n` points distributed uniformly by area over the surface, metres; deterministic for a seed.
   virtual std::vector<Eigen::Vector3d> sample_surface(std::size_t n, std::uint64_t seed) const = 0;
+  /// Lines along which the solid could not tell inside from outside (meshes only; see
+  /// MeshSolid). Analytic solids never fail.
+  virtual long long unresolved_lines() const { return 0; }
 };
 
 /// Counter-based uniform numbers in [0, 1) (SplitMix64), so samples do not depend on threads.

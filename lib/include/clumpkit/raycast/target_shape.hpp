@@ -1,0 +1,35 @@
+#pragma once
+/// The shape a clump is compared with: built from a shape file, a mesh file, or the provenance a
+/// clump template records about its source.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "clumpkit/geometry/clump_template.hpp"
+#include "clumpkit/geometry/shape_spec.hpp"
+#include "clumpkit/raycast/surface_solid.hpp"
+
+namespace clumpkit {
+
+struct TargetShape {
+  std::unique_ptr<SurfaceSolid> solid;  ///< exact cylinder, or a MeshSolid
+  std::string description;              ///< e.g. "cylinder D 6 mm H 5.4 mm" or the mesh path
+  double density = 0.0;                 ///< kg/m^3 if the source says, else 0
+};
+
+/// True for file names that assimp reads as meshes here (.stl .obj .ply .off, any case).
+bool is_mesh_file(const std::filesystem::path& path);
+
+/// A ShapeSpec as a solid: a cylinder exactly, a mesh through load_shape_mesh.
+TargetShape target_from_shape(const ShapeSpec& shape);
+
+/// A mesh file (scale: file units to metres), loaded, validated and oriented.
+TargetShape target_from_mesh(const std::filesystem::path& path, double scale = 1.0);
+
+/// The clump's recorded source, read from its `source` object: `file` naming a shape file
+/// (.toml) or a mesh (with `mesh_scale` or `units`), or `mesh` naming a mesh; else `kind`
+/// "cylinder" with `diameter` and `height` in metres. Throws InputError(where, "source", ...)
+/// when the source is missing or unusable.
+TargetShape target_from_source(const ClumpTemplate& clump, const std::string& where);
+
+}  // namespace clumpkit
