@@ -286,15 +286,15 @@ World World::create(WorldSettings s) {
         }
       }
     const double per = tc_min / w.dt;
-    if (per < 5.0)
+    if (per < 4.0)
       throw InputError(where, "time_step",
                        "time step " + fmt_g(w.dt) + " s is above the stability limit: a " +
                            tc_what + " impact at " + fmt_g(s.max_impact_speed) + " m/s lasts " +
                            fmt_g(tc_min) + " s, only " + fmt_g(per) +
-                           " steps (at least 5 needed, 20 advised)");
-    if (per < 20.0)
+                           " steps (at least 4 needed, 10 advised)");
+    if (per < 10.0)
       w.warnings.push_back("a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) +
-                           " m/s lasts only " + fmt_g(per) + " steps (20 or more advised)");
+                           " m/s lasts only " + fmt_g(per) + " steps (10 or more advised)");
     w.skin = s.skin > 0.0 ? s.skin : 0.3 * w.r_min;
     w.cell = 2.0 * w.r_max + w.skin;
   } else {
