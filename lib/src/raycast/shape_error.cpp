@@ -137,6 +137,14 @@ ShapeError shape_error(const SurfaceSolid& shape, const Spheres& spheres,
   return e;
 }
 
+ShapeError record_shape_error(ClumpTemplate& clump, const SurfaceSolid& shape,
+                              ShapeErrorOptions options) {
+  if (clump.mass.density > 0) options.density = clump.mass.density;
+  ShapeError e = shape_error(shape, clump.spheres_in_source_frame(), options);
+  clump.error = to_json(e);
+  return e;
+}
+
 namespace {
 using nlohmann::json;
 json vec(const Eigen::Vector3d& v) {

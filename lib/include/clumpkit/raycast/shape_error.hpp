@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "clumpkit/geometry/clump_template.hpp"
 #include "clumpkit/geometry/mass_properties.hpp"
 #include "clumpkit/geometry/sphere.hpp"
 #include "clumpkit/raycast/surface_solid.hpp"
@@ -59,6 +60,12 @@ struct ShapeError {
 /// "spheres[i]") and for a non-positive ray or sample count.
 ShapeError shape_error(const SurfaceSolid& shape, const Spheres& spheres,
                        const ShapeErrorOptions& options = {});
+
+/// Measures a clump template against its source shape: the template's spheres are mapped back
+/// to the shape's frame (rotation, translation), the density is the template's, and the figures
+/// (to_json) are stored in `clump.error`. Returns them as well.
+ShapeError record_shape_error(ClumpTemplate& clump, const SurfaceSolid& shape,
+                              ShapeErrorOptions options = {});
 
 /// The figures as JSON, SI units; keys as documented in docs/shape_error.md.
 nlohmann::json to_json(const ShapeError& e);
