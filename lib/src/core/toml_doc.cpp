@@ -88,6 +88,20 @@ double TomlDoc::quantity(const std::string& key, Dimension d) const {
   return *v;
 }
 
+std::optional<Eigen::Vector3d> TomlDoc::vector_opt(const std::string& key, Dimension d) const {
+  const auto* node = static_cast<const toml::node*>(find(key));
+  if (!node) return std::nullopt;
+  std::string where = name_ + ":" + std::to_string(node->source().begin.line);
+  if (auto s = node->value<std::string>()) return parse_vector(*s, d, where, key);
+  fail(key, "expected a vector such as \"0 0 1 " + std::string(si_unit(d)) + "\"");
+}
+
+Eigen::Vector3d TomlDoc::vector(const std::string& key, Dimension d) const {
+  auto v = vector_opt(key, d);
+  if (!v) throw InputError(name_, key, "missing (a vector of " + std::string(dimension_name(d)) + ")");
+  return *v;
+}
+
 std::optional<double> TomlDoc::number_opt(const std::string& key) const {
   return quantity_opt(key, Dimension::Dimensionless);
 }

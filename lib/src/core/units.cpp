@@ -146,7 +146,33 @@ double parse_quantity(std::string_view text, Dimension d, const std::string& whe
     throw InputError(where, field,
                      "'" + std::string(s) + "' has no unit (expected a " + dimension_name(d) +
                          ", e.g. '" + std::string(s) + " " + si_unit(d) + "')");
-  return value * unit_factor(unit, d, where, field);
+  const double si = value * unit_factor(unit, d, where, field);
+  if (!std::isfinite(si))  // "1e308 g/cm^3": finite as written, not in SI
+    throw InputError(where, field, "value '" + std::string(s) + "' is out of range");
+  return si;
+}
+
+Eigen::Vector3d parse_vector(std::string_view text, Dimension d, const std::string& where,
+                             const std::string& field) {
+  std::string_view s = trim(text);
+  Eigen::Vector3d v;
+  for (int k = 0; k < 3; ++k) {
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == ',')) s.remove_prefix(1);
+    double x = 0.0;
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), x);
+    if (ec != std::errc() || ptr == s.data())
+      throw InputError(where, field,
+                       "'" + std::string(text) + "' is not three numbers and a unit (e.g. \"0 0 " +
+                           "-9.81 m/s^2\")");
+    if (!std::isfinite(x)) throw InputError(where, field, "'" + std::string(text) + "' is not finite");
+    v[k] = x;
+    s.remove_prefix(static_cast<size_t>(ptr - s.data()));
+  }
+  s = trim(s);
+  if (s.empty() && d != Dimension::Dimensionless)
+    throw InputError(where, field, "'" + std::string(text) + "' has no unit (expected a " +
+                                       dimension_name(d) + " in " + si_unit(d) + ")");
+  return v * unit_factor(s, d, where, field);
 }
 
 }  // namespace clumpkit

@@ -33,6 +33,9 @@ class TomlDoc {
   /// A quantity: a string "6.0 mm", or a bare number for Dimensionless. Must be finite.
   double quantity(const std::string& key, Dimension d) const;
   std::optional<double> quantity_opt(const std::string& key, Dimension d) const;
+  /// A 3-vector with one unit: "0 0 -9.81 m/s^2".
+  Eigen::Vector3d vector(const std::string& key, Dimension d) const;
+  std::optional<Eigen::Vector3d> vector_opt(const std::string& key, Dimension d) const;
   double number(const std::string& key) const;  // bare dimensionless number
   std::optional<double> number_opt(const std::string& key) const;
   std::string string(const std::string& key) const;

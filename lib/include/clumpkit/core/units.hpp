@@ -1,6 +1,7 @@
 #pragma once
 /// Quantities with units in human-edited files: "6.0 mm", "1380 kg/m^3", "200 mm/min".
 /// Everything inside clumpkit is SI; units exist only at the file boundary.
+#include <Eigen/Core>
 #include <string>
 #include <string_view>
 
@@ -30,6 +31,10 @@ const char* dimension_name(Dimension d);
 /// another dimension, or a non-finite value. A bare number is accepted only for Dimensionless.
 double parse_quantity(std::string_view text, Dimension d, const std::string& where = "",
                       const std::string& field = "");
+
+/// Parses a 3-vector "0 0 -9.81 m/s^2" (three numbers, one unit for all) into SI.
+Eigen::Vector3d parse_vector(std::string_view text, Dimension d, const std::string& where = "",
+                             const std::string& field = "");
 
 /// Factor that converts one unit to SI; throws InputError if unknown or of another dimension.
 double unit_factor(std::string_view unit, Dimension d, const std::string& where = "",
