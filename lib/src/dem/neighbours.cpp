@@ -103,10 +103,14 @@ void World::Impl::rebuild_neighbours() {
   pairs.swap(next);
   pair_hist.swap(next_hist);
 
-  // Wall triangles binned into the cells their (grown) bounding boxes touch.
-  std::vector<std::pair<std::uint64_t, std::array<int, 2>>> tri_bins;
+  // Wall triangles binned into the cells their (grown) bounding boxes touch; static walls keep
+  // their bins.
+  bool walls_moved = !tri_bins_valid;
+  for (const WallData& wd : walls)
+    if (wd.vertices != wd.vertices_build) walls_moved = true;
   const double grow = r_max + skin;
-  for (size_t wi = 0; wi < walls.size(); ++wi) {
+  if (walls_moved) tri_bins.clear();
+  for (size_t wi = 0; wi < walls.size() && walls_moved; ++wi) {
     const WallData& wd = walls[wi];
     for (size_t ti = 0; ti < wd.triangles.size(); ++ti) {
       const auto& t = wd.triangles[ti];
@@ -123,7 +127,8 @@ void World::Impl::rebuild_neighbours() {
             tri_bins.push_back({cell_key(x, y, z), {int(wi), int(ti)}});
     }
   }
-  std::sort(tri_bins.begin(), tri_bins.end());
+  if (walls_moved) std::sort(tri_bins.begin(), tri_bins.end());
+  tri_bins_valid = true;
   std::vector<std::vector<std::array<int, 2>>> cand(ns);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {

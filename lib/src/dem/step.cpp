@@ -38,6 +38,8 @@ void rotate_momentum(Eigen::Vector3d& pi, int k, double theta) {
 
 void World::step() {
   Impl& w = *impl_;
+  if (w.settings.threads <= 0)
+    w.threads = static_cast<long>(w.s_r.size()) >= kAutoThreadsMin ? w.max_threads : 1;
   w.ensure_forces();
   auto t0 = Clock::now();
   w.kick_and_drift();

@@ -303,7 +303,8 @@ World World::create(WorldSettings s) {
     w.cell = w.skin;
     w.r_min = w.r_max = 0.0;
   }
-  w.threads = s.threads > 0 ? s.threads : omp_get_max_threads();
+  w.max_threads = omp_get_max_threads();
+  w.threads = s.threads > 0 ? s.threads : 1;
   w.wall_cand_start.assign(1, 0);
   w.settings = std::move(s);
   w.move_walls();

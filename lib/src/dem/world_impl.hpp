@@ -54,6 +54,9 @@ inline constexpr int kWallSlots = 4;  // wall contacts kept per sphere
 // Loops shorter than this run on one thread: a parallel region costs more than it saves, and a
 // lot more on a loaded machine. Results do not depend on it (see determinism tests).
 inline constexpr int kParallelMin = 512;
+// With threads = 0 (auto) a scene runs on one thread below this many spheres: OpenMP barriers
+// cost more than they save there, and far more when the machine is shared (see docs/dem.md).
+inline constexpr long kAutoThreadsMin = 20000;
 
 struct WallSlot {
   int wall = -1;  // −1 = unused
@@ -86,7 +89,8 @@ struct World::Impl {
   double dt = 0.0;
   double time = 0.0;
   long steps = 0;
-  int threads = 1;
+  int threads = 1;       // threads used by the current step
+  int max_threads = 1;   // all cores, for threads = 0 (auto)
   std::vector<std::string> warnings;
   Profile profile;
 
@@ -118,6 +122,9 @@ struct World::Impl {
   std::vector<ContactHistory> pair_hist;
   std::vector<int> wall_cand_start;
   std::vector<std::array<int, 2>> wall_cand;
+  // Wall triangles binned by cell, reused while no wall has moved since the binning.
+  std::vector<std::pair<std::uint64_t, std::array<int, 2>>> tri_bins;
+  bool tri_bins_valid = false;
   std::vector<std::array<WallSlot, kWallSlots>> wall_slots;
   bool need_rebuild = true;
   double skin = 0.0, cell = 0.0, r_max = 0.0, r_min = 0.0;
