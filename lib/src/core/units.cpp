@@ -43,6 +43,8 @@ const std::vector<Unit>& units() {
       {"kPa", Dimension::Pressure, 1e3},
       {"MPa", Dimension::Pressure, 1e6},
       {"GPa", Dimension::Pressure, 1e9},
+      {"J/m^3", Dimension::Pressure, 1.0},  // energy density (cohesion) has pressure's dimension
+      {"kJ/m^3", Dimension::Pressure, 1e3},
       {"m/s", Dimension::Velocity, 1.0},
       {"mm/s", Dimension::Velocity, 1e-3},
       {"mm/min", Dimension::Velocity, 1e-3 / 60.0},
