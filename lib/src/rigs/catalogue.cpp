@@ -23,15 +23,23 @@ const SettingInfo* RigInfo::setting(const std::string& k) const {
 const std::vector<RigInfo>& rig_catalogue() {
   static const std::vector<RigInfo> rigs = [] {
     const double deg = std::numbers::pi / 180.0;
-    const SettingInfo scale{"scale", {"mini", "small", "paper"}, "", "mini",
+    const SettingInfo scale{"scale",
+                            {"mini", "small", "paper"},
+                            "",
+                            "mini",
                             "rig size: mini (quick), small, paper (the paper's sizes)"};
     const std::vector<std::string> walls = {"abs_plastic", "organic_glass", "galvanized_steel"};
+    // A speed-up, not physics: every Young's modulus times this factor (the scale sets it).
+    const SettingInfo stiffness{
+        "stiffness", {}, "1", "1", "factor on every Young's modulus (scale default; 1 = Table 1)"};
     std::vector<RigInfo> r;
-    r.push_back({"bulk_density",
-                 "0.26 L organic-glass cylinder, pour to overflow, strike off, weigh",
-                 {{"bulk_density", Dimension::Density, "kg/m^3", 1.0, "mass in the cylinder / 0.26 L"}},
-                 {scale,
-                  {"wall", walls, "", "organic_glass", "material of the measuring cylinder"}}});
+    r.push_back(
+        {"bulk_density",
+         "0.26 L organic-glass cylinder, pour to overflow, strike off, weigh",
+         {{"bulk_density", Dimension::Density, "kg/m^3", 1.0, "mass in the cylinder / 0.26 L"}},
+         {scale,
+          {"wall", walls, "", "organic_glass", "material of the measuring cylinder"},
+          stiffness}});
     r.push_back({"angle_of_repose",
                  "lifting cylinder (200 mm/min) on a plate; heap angle from side silhouettes",
                  {{"angle", Dimension::Angle, "deg", deg, "mean of both flanks"},
@@ -39,14 +47,24 @@ const std::vector<RigInfo>& rig_catalogue() {
                   {"angle_right", Dimension::Angle, "deg", deg, "right flank"}},
                  {scale,
                   {"plate", walls, "", "galvanized_steel", "material of the base plate"},
-                  {"lift_speed", {}, "mm/min", "200", "lifting speed of the cylinder"}}});
+                  {"lift_speed", {}, "mm/min", "200", "lifting speed of the cylinder"},
+                  {"mass", {}, "kg", "0.5", "pill mass poured into the cylinder (scale default)"},
+                  stiffness}});
     r.push_back({"discharge",
                  "hopper and 8-pocket wheel at a given speed",
                  {{"pocket_mass", Dimension::Mass, "kg", 1.0, "mean mass per pocket"},
                   {"pocket_mass_cv", Dimension::Dimensionless, "1", 1.0,
                    "coefficient of variation of the pocket mass"},
                   {"mass_flow", Dimension::MassFlow, "kg/s", 1.0, "discharged mass per second"}},
-                 {scale, {"rpm", {}, "rpm", "15", "wheel speed"}}});
+                 {scale,
+                  {"rpm", {}, "rpm", "15", "wheel speed"},
+                  {"slice",
+                   {},
+                   "mm",
+                   "100",
+                   "length of the wheel slice along its axis (scale default; paper 100 mm)"},
+                  {"pockets", {}, "1", "8", "pockets measured after the first (scale default)"},
+                  stiffness}});
     return r;
   }();
   return rigs;
@@ -81,15 +99,15 @@ std::map<std::string, std::string> parse_settings(const RigInfo& rig, const std:
     item = trim(item);
     if (item.empty()) continue;
     const auto eq = item.find('=');
-    if (eq == std::string::npos)
-      throw InputError(where, field, "'" + item + "' is not key=value");
+    if (eq == std::string::npos) throw InputError(where, field, "'" + item + "' is not key=value");
     const std::string key = trim(item.substr(0, eq)), value = trim(item.substr(eq + 1));
     const SettingInfo* s = rig.setting(key);
     if (!s) {
       std::string known;
       for (const auto& k : rig.settings) known += (known.empty() ? "" : ", ") + k.key;
-      throw InputError(where, field,
-                       "rig '" + rig.name + "' has no setting '" + key + "' (known: " + known + ")");
+      throw InputError(
+          where, field,
+          "rig '" + rig.name + "' has no setting '" + key + "' (known: " + known + ")");
     }
     if (out.count(key)) throw InputError(where, field, "setting '" + key + "' given twice");
     if (!s->choices.empty()) {
@@ -107,9 +125,9 @@ std::map<std::string, std::string> parse_settings(const RigInfo& rig, const std:
       char* end = nullptr;
       const double v = std::strtod(value.c_str(), &end);
       if (value.empty() || !end || *end != 0 || !std::isfinite(v) || v <= 0)
-        throw InputError(where, field,
-                         "setting " + key + "='" + value + "' must be a positive number in " +
-                             s->unit);
+        throw InputError(
+            where, field,
+            "setting " + key + "='" + value + "' must be a positive number in " + s->unit);
       std::ostringstream num;
       num << v;
       out[key] = num.str();

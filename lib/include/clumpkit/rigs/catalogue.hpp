@@ -19,9 +19,9 @@ struct QuantityInfo {
 };
 
 struct SettingInfo {
-  std::string key;                  ///< e.g. "rpm"
-  std::vector<std::string> choices; ///< allowed values; empty: a number with `unit`
-  std::string unit;                 ///< unit of a numeric setting ("rpm"); empty for choices
+  std::string key;                   ///< e.g. "rpm"
+  std::vector<std::string> choices;  ///< allowed values; empty: a number with `unit`
+  std::string unit;                  ///< unit of a numeric setting ("rpm"); empty for choices
   std::string default_value;
   std::string description;
 };

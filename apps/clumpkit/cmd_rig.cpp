@@ -1,0 +1,166 @@
+// clumpkit rig: run one of the paper's validation rigs with a particle model (SPEC §7).
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "cli_util.hpp"
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/rigs/catalogue.hpp"
+#include "clumpkit/rigs/geometry.hpp"
+#include "clumpkit/rigs/model.hpp"
+#include "clumpkit/rigs/rig.hpp"
+
+namespace clumpkit::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RigArgs {
+  std::string rig, model = "production", scale, json, out, meshes;
+  int repeats = 1;
+  std::uint64_t seed = 1;
+  std::vector<std::string> sets;
+  bool vtk = false, list = false;
+  int threads = 0;
+  long rays = 20000;
+};
+
+fs::path resolve_model(const std::string& arg) {
+  std::error_code ec;
+  if (fs::exists(arg, ec) && fs::is_regular_file(arg, ec)) return arg;
+  for (const fs::path& cand :
+       {data_dir() / "shapes" / "models" / (arg + ".toml"), data_dir() / "shapes" / "models" / arg})
+    if (fs::exists(cand, ec)) return cand;
+  std::string known;
+  for (const auto& e : fs::directory_iterator(data_dir() / "shapes" / "models", ec))
+    if (e.path().extension() == ".toml")
+      known += (known.empty() ? "" : ", ") + e.path().stem().string();
+  throw InputError("--model", "",
+                   "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
+}
+
+void list_rigs() {
+  for (const auto& r : rig_catalogue()) {
+    std::cout << fmt::format("{}: {}\n  quantities:", r.name, r.description);
+    for (const auto& q : r.quantities) std::cout << fmt::format(" {} ({})", q.name, q.unit);
+    std::cout << "\n  settings (--set key=value):\n";
+    for (const auto& s : r.settings) {
+      std::string v = s.choices.empty() ? s.unit : "";
+      for (const auto& c : s.choices) v += (v.empty() ? "" : "|") + c;
+      std::cout << fmt::format("    {:<11} {:<36} default {:<8} {}\n", s.key, v, s.default_value,
+                               s.description);
+    }
+  }
+  std::cout << "model effects (--set effects.NAME[.PARTNER]=VALUE|on|off):";
+  for (const auto& e : effect_names()) std::cout << " " << e;
+  std::cout << "\n";
+}
+
+Command setup(CLI::App& parent) {
+  auto a = std::make_shared<RigArgs>();
+  CLI::App* c = parent.add_subcommand(
+      "rig",
+      "Run a validation rig (bulk_density, angle_of_repose, discharge) with a particle "
+      "model through the DEM engine; repeats give mean and standard deviation (SI units)");
+  c->add_option("name", a->rig, "Rig: bulk_density | angle_of_repose | discharge");
+  c->add_option("--model", a->model,
+                "Particle model: a file or a bundled name (shapes/models/: production, "
+                "paper_A12, ...)")
+      ->capture_default_str();
+  c->add_option("--scale", a->scale, "mini (quick) | small | paper (the paper's sizes)");
+  c->add_option("--repeats", a->repeats, "Repeats with seeds seed, seed+1, ...")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  c->add_option("--seed", a->seed, "Seed of the first repeat")->capture_default_str();
+  c->add_option("--set", a->sets,
+                "key=value: a rig setting (see --list; e.g. rpm=30, plate=abs_plastic, "
+                "lift_speed=200) or a model effect (effects.rolling_friction.pill=0.1, "
+                "effects.cohesion=\"2e4 J/m^3\", effects.restitution=off)");
+  c->add_option("--json", a->json, "Write the result as JSON (FILE or -)");
+  c->add_option("--out", a->out,
+                "Folder for checkpoints, per-repeat results and pictures (a rerun resumes and "
+                "keeps finished repeats)");
+  c->add_flag("--vtk", a->vtk, "Also write VTK (.vtp) snapshots of spheres and walls to --out");
+  c->add_option("--threads", a->threads, "Threads (0 = all)")->check(CLI::NonNegativeNumber);
+  c->add_option("--rays", a->rays, "Rays for the clumps' mass properties")
+      ->check(CLI::PositiveNumber);
+  c->add_flag("--list", a->list, "List the rigs, their quantities, settings and the effects");
+  c->add_option("--write-meshes", a->meshes,
+                "Write the rigs' wall meshes (paper size, STL in metres) to this folder and exit");
+  return {c, [a] {
+            if (a->list) {
+              list_rigs();
+              return 0;
+            }
+            if (!a->meshes.empty()) {
+              for (const auto& n : rigs::write_rig_meshes(a->meshes))
+                std::cout << (fs::path(a->meshes) / n).string() << "\n";
+              return 0;
+            }
+            if (a->rig.empty()) throw InputError("", "name", "give a rig name (see --list)");
+            const RigInfo& info = find_rig(a->rig, "", "rig");
+            rigs::RigRequest req;
+            req.rig = info.name;
+            req.model = load_model(resolve_model(a->model), data_dir());
+            std::string settings = a->scale.empty() ? "" : "scale=" + a->scale;
+            for (const auto& s : a->sets) {
+              const auto eq = s.find('=');
+              if (eq == std::string::npos) throw InputError("--set", s, "expected key=value");
+              const std::string key = s.substr(0, eq), value = s.substr(eq + 1);
+              if (key.rfind("effects.", 0) == 0)
+                set_model_effect(req.model, key, value, "--set");
+              else
+                settings += (settings.empty() ? "" : ";") + s;
+            }
+            req.settings = parse_settings(info, settings, "--set", "");
+            if (!req.settings.count("scale")) req.settings["scale"] = "mini";
+            req.repeats = a->repeats;
+            req.seed = a->seed;
+            req.vtk = a->vtk;
+            req.threads = a->threads;
+            req.rays = a->rays;
+            if (a->vtk && a->out.empty())
+              throw InputError("--vtk", "", "VTK output needs --out DIR");
+            if (!a->out.empty()) {
+              std::error_code ec;
+              fs::create_directories(a->out, ec);
+              check_writable(fs::path(a->out) / "x.json", "--out");
+              req.out = a->out;
+            }
+            if (!a->json.empty() && a->json != "-") check_writable(a->json, "--json");
+            req.progress = [](const std::string& s) { std::cerr << s << std::endl; };
+            // Scale parameters are checked before the long run starts.
+            (void)rigs::rig_scale(req.rig, req.settings);
+
+            const rigs::RigResult r = rigs::run_rig(req);
+            std::cout << fmt::format("{} with model {} at scale {} ({}), {} repeat(s)\n", r.rig,
+                                     r.model, r.scale, format_settings(r.settings),
+                                     r.repeats.size());
+            std::cout << fmt::format("{:<16} {:>12} {:>12} {:>3}  {}\n", "quantity", "mean", "std",
+                                     "n", "unit");
+            for (const auto& q : info.quantities) {
+              const auto it = r.stats.find(q.name);
+              if (it == r.stats.end()) continue;
+              std::cout << fmt::format("{:<16} {:>12.5g} {:>12.5g} {:>3}  {}\n", q.name,
+                                       it->second.mean / q.to_si, it->second.std / q.to_si,
+                                       it->second.n, q.unit);
+            }
+            for (const auto& rep : r.repeats)
+              std::cout << fmt::format("  seed {}: {:.1f} s wall{}\n", rep.seed, rep.wall_seconds,
+                                       rep.resumed ? " (kept from an earlier run)" : "");
+            if (!a->json.empty()) write_json(r.to_json(), a->json);
+            if (!r.error.empty()) {
+              std::cerr << "clumpkit rig: " << r.error
+                        << (r.repeats.empty() ? "" : " (finished repeats kept)") << std::endl;
+              return 2;
+            }
+            return 0;
+          }};
+}
+
+const Registration reg(40, setup);
+
+}  // namespace
+}  // namespace clumpkit::cli

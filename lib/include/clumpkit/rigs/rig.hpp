@@ -1,0 +1,98 @@
+#pragma once
+/// The paper's validation rigs run through the bundled DEM engine (SPEC §7): factory → pour →
+/// settle → the rig's action → measurement, repeated with different seeds.
+///
+/// Each repeat runs in two phases (pour and settle; then the action with the settled bed). The
+/// action's wall motion starts when the bed has settled, so phase 2 is a new World whose walls
+/// move from that time, seeded with the settled clumps (positions, orientations, velocities;
+/// the tangential contact springs restart from zero). Both phases checkpoint through the
+/// engine, so a killed run resumes where it stopped and finished repeats are kept.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "clumpkit/rigs/catalogue.hpp"
+#include "clumpkit/rigs/model.hpp"
+
+namespace clumpkit::rigs {
+
+/// Numbers that size a rig at one scale. Defaults are filled by rig_scale(); every field is
+/// reported in the result's JSON so a run documents itself.
+struct ScaleParams {
+  std::string name;                ///< mini | small | paper
+  double stiffness_scale = 1.0;    ///< factor on every Young's modulus (speed-up, see docs)
+  double rayleigh_fraction = 0.2;  ///< time step / Rayleigh time
+  double settle_speed = 0.005;     ///< m/s, RMS clump speed below which a bed is at rest
+  double settle_max = 2.0;         ///< s of simulated time allowed for one settle
+  // bulk_density
+  double cup_diameter = 0.070, cup_height = 0.0676;  ///< m
+  double pour_rate = 0.5;                            ///< kg/s
+  double scraper_speed = 0.05;                       ///< m/s
+  // angle_of_repose
+  double tube_diameter = 0.0657, tube_height = 0.150;  ///< m
+  double plate_side = 0.5;                             ///< m
+  double heap_mass = 0.5;                              ///< kg poured into the tube
+  double lift_speed = 200.0 / 60000.0;                 ///< m/s
+  double lift_height = 0.0;  ///< m the tube rises; 0 = until it clears the bed
+  // discharge
+  double wheel_scale = 1.0;     ///< factor on the wheel's radii and the hopper (1 = paper)
+  double slice_length = 0.100;  ///< m along the wheel axis (paper: 0.1 m pockets)
+  double bed_mass = 10.0;       ///< kg in the hopper
+  double rpm = 15.0;
+  int pockets_skipped = 1;  ///< pockets closing first (filled at rest) not counted
+  int pockets_measured = 8;
+};
+
+/// The scale's parameters for a rig with its (parsed) settings applied. Throws InputError for a
+/// setting the scale cannot honour.
+ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::string>& settings);
+
+struct RigRequest {
+  std::string rig;
+  ParticleModel model;
+  std::map<std::string, std::string> settings;  ///< parsed by parse_settings (scale included)
+  int repeats = 1;
+  std::uint64_t seed = 1;             ///< repeat k uses seed + k
+  std::filesystem::path out;          ///< checkpoints, per-repeat results, pictures; empty = none
+  bool vtk = false;                   ///< write VTK (.vtp) snapshots for ParaView into `out`
+  int threads = 0;                    ///< 0 = all
+  long rays = 20000;                  ///< ray sampling of the clumps' mass properties
+  double checkpoint_interval = 60.0;  ///< s of wall-clock time between checkpoints
+  std::function<void(const std::string&)> progress;  ///< one line per call, may be empty
+};
+
+struct RepeatResult {
+  std::uint64_t seed = 0;
+  std::map<std::string, double> values;  ///< quantity name → value in SI units
+  nlohmann::json details;                ///< rig-specific figures (SI), settle info, timings
+  double wall_seconds = 0.0;
+  bool resumed = false;
+};
+
+struct QuantityStats {
+  double mean = 0.0, std = 0.0;  ///< SI; std of the repeats (0 for one repeat)
+  int n = 0;
+};
+
+struct RigResult {
+  std::string rig, model, scale;
+  std::map<std::string, std::string> settings;
+  ScaleParams params;
+  std::vector<RepeatResult> repeats;
+  std::map<std::string, QuantityStats> stats;  ///< per quantity, SI
+  std::string error;  ///< set when a repeat failed (blow-up); finished repeats are kept
+  nlohmann::json to_json() const;
+};
+
+/// Runs all repeats. A repeat that blows up stops the run: the result then holds the finished
+/// repeats and `error`; the caller decides the exit status.
+RigResult run_rig(const RigRequest& request);
+
+/// Mean and sample standard deviation of the repeats' values.
+std::map<std::string, QuantityStats> repeat_stats(const std::vector<RepeatResult>& repeats);
+
+}  // namespace clumpkit::rigs

@@ -1,0 +1,485 @@
+#include "clumpkit/rigs/model.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/core/toml_doc.hpp"
+#include "clumpkit/fill/paper_fill.hpp"
+#include "clumpkit/geometry/mass_properties.hpp"
+
+namespace clumpkit {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string>& effect_names() {
+  static const std::vector<std::string> n = {
+      "rolling_friction", "particle_friction", "wall_friction",     "restitution",
+      "cohesion",         "shape_resolution",  "size_distribution", "rolling_model"};
+  return n;
+}
+
+void check_effect_name(const std::string& name, const std::string& where,
+                       const std::string& field) {
+  const auto& n = effect_names();
+  if (std::find(n.begin(), n.end(), name) != n.end()) return;
+  std::string known;
+  for (const auto& e : n) known += (known.empty() ? "" : ", ") + e;
+  throw InputError(where, field, "unknown effect '" + name + "' (known: " + known + ")");
+}
+
+const char* to_string(MassBasis b) {
+  switch (b) {
+    case MassBasis::kSphereUnion:
+      return "sphere_union";
+    case MassBasis::kTrueShape:
+      return "true_shape";
+    case MassBasis::kGiven:
+      return "given";
+  }
+  return "?";
+}
+
+bool ModelEffects::on(const std::string& e) const {
+  if (e == "rolling_friction") return rolling_friction.has_value();
+  if (e == "particle_friction") return particle_friction.has_value();
+  if (e == "wall_friction") return wall_friction.has_value();
+  if (e == "restitution") return restitution.has_value();
+  if (e == "cohesion") return cohesion.has_value();
+  if (e == "shape_resolution") return shape_resolution.has_value();
+  if (e == "size_distribution") return size_distribution;
+  if (e == "rolling_model") return rolling_model.has_value();
+  return false;
+}
+
+namespace {
+
+// A relative path: next to the file that names it, else in the bundled data folder.
+fs::path resolve(const fs::path& p, const fs::path& base, const fs::path& data_dir) {
+  if (p.is_absolute()) return p;
+  const fs::path local = base / p;
+  if (fs::exists(local) || data_dir.empty()) return local;
+  const fs::path bundled = data_dir / p;
+  return fs::exists(bundled) ? bundled : local;
+}
+
+// Per-partner values "pill = 0.08", "abs_plastic = 0.12" of an effect table; `defaults` fills
+// the partners the file does not give.
+std::map<std::string, double> partner_values(const TomlDoc& doc, const std::string& table,
+                                             const std::set<std::string>& reserved, double lo,
+                                             double hi, bool lo_open) {
+  std::map<std::string, double> out;
+  for (const auto& k : doc.keys(table)) {
+    if (reserved.count(k)) continue;
+    const std::string key = table + "." + k;
+    const double v = doc.number(key);
+    doc.require_range(key, v, lo, hi, lo_open, false);
+    out[k] = v;
+  }
+  return out;
+}
+
+// Effect tables are either `name = true` / `name = false` or a table `[effects.name]`.
+bool effect_listed(const TomlDoc& doc, const std::string& e, bool& as_table) {
+  const std::string key = "effects." + e;
+  as_table = false;
+  if (!doc.has(key)) return false;
+  try {
+    doc.keys(key);  // throws unless a table
+    as_table = true;
+    return true;
+  } catch (const InputError&) {
+    return *doc.boolean_opt(key);  // throws "expected true or false" for anything else
+  }
+}
+
+double interaction_or(const MaterialLibrary& lib, const std::string& other,
+                      double Interaction::*field, const std::string& where) {
+  return lib.interaction("pill", other, where).*field;
+}
+
+}  // namespace
+
+ParticleModel parse_model(const std::string& text, const fs::path& path, const fs::path& data_dir) {
+  const TomlDoc doc = TomlDoc::parse(text, path.string());
+  const std::string where = path.string();
+  const fs::path base = path.has_parent_path() ? path.parent_path() : fs::path(".");
+
+  // Unknown top-level tables are typos: refuse them.
+  for (const auto& k : doc.keys("")) {
+    static const std::set<std::string> known = {"model", "types", "effects"};
+    if (!known.count(k)) doc.fail(k, "unknown section (known: model, types, effects)");
+  }
+
+  ParticleModel m;
+  m.path = path;
+  m.name = doc.string_opt("model.name").value_or(path.stem().string());
+  m.description = doc.string_opt("model.description").value_or("");
+  if (auto mp = doc.string_opt("model.materials")) {
+    m.materials_path = resolve(*mp, base, data_dir);
+    try {
+      m.materials = MaterialLibrary::load(m.materials_path);
+    } catch (const InputError& e) {
+      if (!fs::exists(m.materials_path))
+        doc.fail("model.materials", "file '" + *mp + "' not found");
+      throw;
+    }
+  }
+  if (!m.materials.has("pill")) doc.fail("model.materials", "the library has no material 'pill'");
+  const std::string basis = doc.string_opt("model.mass_basis").value_or("sphere_union");
+  if (basis == "sphere_union")
+    m.mass_basis = MassBasis::kSphereUnion;
+  else if (basis == "true_shape")
+    m.mass_basis = MassBasis::kTrueShape;
+  else if (basis == "given")
+    m.mass_basis = MassBasis::kGiven;
+  else
+    doc.fail("model.mass_basis", "'" + basis + "' is not one of: sphere_union, true_shape, given");
+
+  // Types.
+  const size_t nt = doc.array_size("types");
+  if (nt == 0) doc.fail("types", "a model needs at least one [[types]] entry");
+  double fsum = 0.0;
+  std::set<std::string> names;
+  for (size_t i = 0; i < nt; ++i) {
+    const std::string p = "types." + std::to_string(i) + ".";
+    for (const auto& k : doc.keys("types." + std::to_string(i))) {
+      static const std::set<std::string> known = {"name",  "shape",         "paper_spheres",
+                                                  "clump", "mass_fraction", "mass"};
+      if (!known.count(k))
+        doc.fail(p + k,
+                 "unknown key (known: name, shape, paper_spheres, clump, mass_fraction, mass)");
+    }
+    ModelType t;
+    t.name = doc.string(p + "name");
+    if (t.name.empty() || !names.insert(t.name).second)
+      doc.fail(p + "name", "type names must be non-empty and unique");
+    const std::string shape = doc.string(p + "shape");
+    t.shape_path = resolve(shape, base, data_dir);
+    if (!fs::exists(t.shape_path)) doc.fail(p + "shape", "file '" + shape + "' not found");
+    t.shape = load_shape(t.shape_path);
+    const bool has_rule = doc.has(p + "paper_spheres"), has_clump = doc.has(p + "clump");
+    if (has_rule == has_clump)
+      doc.fail(p + (has_rule ? "clump" : "paper_spheres"),
+               "give exactly one of paper_spheres (the paper's rule) and clump (a template file)");
+    if (has_rule) {
+      const long long n = doc.integer(p + "paper_spheres");
+      doc.require_range(p + "paper_spheres", double(n), 1, 1000);
+      t.paper_spheres = int(n);
+    } else {
+      const std::string c = doc.string(p + "clump");
+      t.clump_path = resolve(c, base, data_dir);
+      if (!fs::exists(t.clump_path)) doc.fail(p + "clump", "file '" + c + "' not found");
+    }
+    t.mass_fraction = doc.number_opt(p + "mass_fraction").value_or(t.shape.mass_fraction);
+    doc.require_range(p + "mass_fraction", t.mass_fraction, 0.0, 1.0, true, false);
+    if (m.mass_basis == MassBasis::kGiven) {
+      if (!doc.has(p + "mass"))
+        doc.fail(p + "mass", "mass_basis = \"given\" needs a mass per pill");
+      t.given_mass = doc.quantity(p + "mass", Dimension::Mass);
+      doc.require_range(p + "mass", *t.given_mass, 0.0, 1e3, true, false);
+    } else if (doc.has(p + "mass")) {
+      doc.fail(p + "mass", "a given mass needs model.mass_basis = \"given\"");
+    }
+    fsum += t.mass_fraction;
+    m.types.push_back(std::move(t));
+  }
+  for (auto& t : m.types) t.mass_fraction /= fsum;
+
+  // Effects.
+  for (const auto& k : doc.keys("effects")) check_effect_name(k, where, "effects." + k);
+  ModelEffects& fx = m.effects;
+  const MaterialLibrary& lib = m.materials;
+  bool tbl = false;
+  auto walls_of = [&]() {
+    std::vector<std::string> w;
+    for (const auto& n : lib.names())
+      if (n != "pill" && lib.has_interaction("pill", n)) w.push_back(n);
+    return w;
+  };
+  auto check_partners = [&](const std::string& table, const std::map<std::string, double>& vals,
+                            bool walls_only) {
+    for (const auto& [k, v] : vals) {
+      if (!lib.has(k) || !lib.has_interaction("pill", k))
+        doc.fail(table + "." + k, "no material '" + k + "' interacting with 'pill' in the library");
+      if (walls_only && k == "pill")
+        doc.fail(table + "." + k, "pill–pill friction is the effect particle_friction");
+    }
+  };
+  if (effect_listed(doc, "rolling_friction", tbl)) {
+    std::map<std::string, double> v;
+    if (tbl) v = partner_values(doc, "effects.rolling_friction", {}, 0.0, 10.0, false);
+    check_partners("effects.rolling_friction", v, false);
+    for (const auto& w : walls_of())
+      if (!v.count(w)) v[w] = interaction_or(lib, w, &Interaction::rolling_friction, where);
+    if (!v.count("pill"))
+      v["pill"] = interaction_or(lib, "pill", &Interaction::rolling_friction, where);
+    fx.rolling_friction = v;
+  }
+  if (effect_listed(doc, "particle_friction", tbl)) {
+    double v = interaction_or(lib, "pill", &Interaction::static_friction, where);
+    if (tbl) {
+      for (const auto& k : doc.keys("effects.particle_friction"))
+        if (k != "value") doc.fail("effects.particle_friction." + k, "unknown key (known: value)");
+      if (auto x = doc.number_opt("effects.particle_friction.value")) {
+        doc.require_range("effects.particle_friction.value", *x, 0.0, 10.0);
+        v = *x;
+      }
+    }
+    fx.particle_friction = v;
+  }
+  if (effect_listed(doc, "wall_friction", tbl)) {
+    std::map<std::string, double> v;
+    if (tbl) v = partner_values(doc, "effects.wall_friction", {}, 0.0, 10.0, false);
+    check_partners("effects.wall_friction", v, true);
+    for (const auto& w : walls_of())
+      if (!v.count(w)) v[w] = interaction_or(lib, w, &Interaction::static_friction, where);
+    fx.wall_friction = v;
+  }
+  if (effect_listed(doc, "restitution", tbl)) {
+    std::map<std::string, double> v;
+    if (tbl) v = partner_values(doc, "effects.restitution", {}, 0.0, 1.0, true);
+    check_partners("effects.restitution", v, false);
+    for (const auto& w : walls_of())
+      if (!v.count(w)) v[w] = interaction_or(lib, w, &Interaction::restitution, where);
+    if (!v.count("pill")) v["pill"] = interaction_or(lib, "pill", &Interaction::restitution, where);
+    fx.restitution = v;
+  }
+  if (effect_listed(doc, "cohesion", tbl)) {
+    if (!tbl || !doc.has("effects.cohesion.energy_density"))
+      doc.fail("effects.cohesion", "cohesion needs energy_density, e.g. \"2e4 J/m^3\"");
+    for (const auto& k : doc.keys("effects.cohesion"))
+      if (k != "energy_density")
+        doc.fail("effects.cohesion." + k, "unknown key (known: energy_density)");
+    const double k = doc.quantity("effects.cohesion.energy_density", Dimension::Pressure);
+    doc.require_range("effects.cohesion.energy_density", k, 0.0, 1e12);
+    fx.cohesion = k;
+  }
+  if (effect_listed(doc, "shape_resolution", tbl)) {
+    if (!tbl || !doc.has("effects.shape_resolution.spheres"))
+      doc.fail("effects.shape_resolution", "shape_resolution needs spheres = N (paper-rule count)");
+    const long long n = doc.integer("effects.shape_resolution.spheres");
+    doc.require_range("effects.shape_resolution.spheres", double(n), 1, 1000);
+    fx.shape_resolution = int(n);
+  }
+  fx.size_distribution = effect_listed(doc, "size_distribution", tbl);
+  if (m.types.size() > 1 && !fx.size_distribution)
+    doc.fail("effects",
+             "a model with several types needs effects.size_distribution = true "
+             "(without it the population has one size)");
+  if (fx.size_distribution && tbl)
+    for (const auto& k : doc.keys("effects.size_distribution"))
+      doc.fail("effects.size_distribution." + k,
+               "unknown key (the fractions are the types' mass_fraction)");
+  if (effect_listed(doc, "rolling_model", tbl)) {
+    if (!tbl || !doc.has("effects.rolling_model.model"))
+      doc.fail("effects.rolling_model",
+               "rolling_model needs model = \"standard\", \"cdt\" or \"epsd\"");
+    for (const auto& k : doc.keys("effects.rolling_model"))
+      if (k != "model" && k != "viscous_damping")
+        doc.fail("effects.rolling_model." + k, "unknown key (known: model, viscous_damping)");
+    fx.rolling_model = dem::rolling_model_from_string(doc.string("effects.rolling_model.model"),
+                                                      where, "effects.rolling_model.model");
+    if (auto d = doc.number_opt("effects.rolling_model.viscous_damping")) {
+      doc.require_range("effects.rolling_model.viscous_damping", *d, 0.0, 10.0);
+      fx.epsd_damping = *d;
+    }
+    if (!fx.rolling_friction)
+      doc.fail("effects.rolling_model", "a rolling model needs effects.rolling_friction on");
+  }
+  return m;
+}
+
+ParticleModel load_model(const fs::path& path, const fs::path& data_dir) {
+  if (!fs::exists(path)) throw InputError(path.string(), "", "model file not found");
+  return parse_model(read_file(path), path, data_dir);
+}
+
+std::vector<dem::ClumpTypeSettings> ParticleModel::clump_types(long rays) const {
+  std::vector<dem::ClumpTypeSettings> out;
+  for (const ModelType& t : types) {
+    ClumpTemplate c;
+    if (t.paper_spheres || effects.shape_resolution) {
+      PaperFillRequest req;
+      req.spheres = effects.shape_resolution ? *effects.shape_resolution : *t.paper_spheres;
+      req.sampling.rays = rays;
+      if (t.clump_path.empty() || effects.shape_resolution)
+        c = paper_fill_template(t.shape, req);
+      else
+        c = load_clump(t.clump_path);
+    } else {
+      c = load_clump(t.clump_path);
+    }
+    // Mass basis: scale mass and inertia together (the union's mass distribution is kept).
+    double target = c.mass.mass;
+    if (mass_basis == MassBasis::kTrueShape) {
+      if (t.shape.kind != ShapeSpec::Kind::Cylinder)
+        throw InputError(path.string(), "model.mass_basis",
+                         "true_shape needs cylinder shapes (type " + t.name + ")");
+      target = t.shape.density * M_PI * 0.25 * t.shape.diameter * t.shape.diameter * t.shape.height;
+    } else if (mass_basis == MassBasis::kGiven) {
+      target = *t.given_mass;
+    }
+    const double f = target / c.mass.mass;
+    c.mass.mass *= f;
+    c.mass.density *= f;
+    c.mass.inertia_tensor *= f;
+    c.mass.principal_moments *= f;
+    c.mass_method["mass_basis"] = to_string(mass_basis);
+    c.mass_method["mass_scale"] = f;
+    c.name = t.name;
+    out.push_back({t.name, std::move(c), "pill"});
+  }
+  return out;
+}
+
+std::vector<dem::PairContactOverride> ParticleModel::pair_contacts(
+    const std::vector<std::string>& wall_materials) const {
+  std::vector<dem::PairContactOverride> out;
+  const dem::RollingModel rm = effects.rolling_model.value_or(dem::RollingModel::kStandard);
+  auto law_for = [&](const std::string& other) {
+    dem::PairContact law;
+    const bool wall = other != "pill";
+    if (effects.restitution) law.restitution = effects.restitution->at(other);
+    if (wall && effects.wall_friction) law.static_friction = effects.wall_friction->at(other);
+    if (!wall && effects.particle_friction) law.static_friction = *effects.particle_friction;
+    if (effects.rolling_friction) {
+      dem::RollingFriction r;
+      r.model = rm;
+      r.coefficient = effects.rolling_friction->at(other);
+      r.viscous_damping = effects.epsd_damping;
+      law.rolling = r;
+    }
+    if (!wall && effects.cohesion) law.cohesion = dem::Cohesion{*effects.cohesion};
+    return law;
+  };
+  out.push_back({"pill", "pill", law_for("pill")});
+  std::set<std::string> done;
+  for (const auto& w : wall_materials) {
+    if (!done.insert(w).second) continue;
+    if (!materials.has(w) || !materials.has_interaction("pill", w))
+      throw InputError(path.string(), "model.materials",
+                       "the library has no material '" + w + "' interacting with the pill");
+    // Effects whose per-partner map lacks this wall (a library loaded later): library value.
+    dem::PairContact law = law_for(w);
+    out.push_back({"pill", w, law});
+  }
+  return out;
+}
+
+void ParticleModel::configure(dem::WorldSettings& ws, const std::vector<std::string>& walls,
+                              long rays) const {
+  ws.source = path.string();
+  ws.materials = materials;
+  ws.rolling_model = effects.rolling_model.value_or(dem::RollingModel::kStandard);
+  ws.clump_types = clump_types(rays);
+  ws.pair_contacts = pair_contacts(walls);
+}
+
+std::vector<dem::MixtureEntry> ParticleModel::mixture() const {
+  std::vector<dem::MixtureEntry> m;
+  for (const auto& t : types) m.push_back({t.name, t.mass_fraction});
+  return m;
+}
+
+std::string ParticleModel::summary() const {
+  std::string s = fmt::format("model {} ({} basis):", name, to_string(mass_basis));
+  for (const auto& t : types)
+    s += fmt::format(" {} {:.0f}% {}", t.name, 100.0 * t.mass_fraction,
+                     effects.shape_resolution ? fmt::format("{}-sphere", *effects.shape_resolution)
+                     : t.paper_spheres        ? fmt::format("{}-sphere", *t.paper_spheres)
+                                              : t.clump_path.filename().string());
+  s += "; effects on:";
+  for (const auto& e : effect_names())
+    if (effects.on(e)) s += " " + e;
+  return s;
+}
+
+namespace {
+
+double parse_number(const std::string& v, const std::string& where, const std::string& key,
+                    double lo, double hi) {
+  char* end = nullptr;
+  const double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != 0 || !std::isfinite(x) || x < lo || x > hi)
+    throw InputError(where, key, fmt::format("'{}' is not a number in [{}, {}]", v, lo, hi));
+  return x;
+}
+
+}  // namespace
+
+void set_model_effect(ParticleModel& m, const std::string& key, const std::string& value,
+                      const std::string& where) {
+  // key: effects.NAME[.PARTNER]
+  if (key.rfind("effects.", 0) != 0)
+    throw InputError(where, key, "expected effects.NAME[.PARTNER]=VALUE or effects.NAME=off");
+  const std::string rest = key.substr(8);
+  const auto dot = rest.find('.');
+  const std::string name = rest.substr(0, dot);
+  const std::string partner = dot == std::string::npos ? "" : rest.substr(dot + 1);
+  check_effect_name(name, where, key);
+  ModelEffects& fx = m.effects;
+  const MaterialLibrary& lib = m.materials;
+  if (value == "off") {
+    if (!partner.empty()) throw InputError(where, key, "'off' switches a whole effect off");
+    if (name == "rolling_friction") fx.rolling_friction.reset(), fx.rolling_model.reset();
+    if (name == "particle_friction") fx.particle_friction.reset();
+    if (name == "wall_friction") fx.wall_friction.reset();
+    if (name == "restitution") fx.restitution.reset();
+    if (name == "cohesion") fx.cohesion.reset();
+    if (name == "shape_resolution") fx.shape_resolution.reset();
+    if (name == "rolling_model") fx.rolling_model.reset();
+    if (name == "size_distribution") {
+      if (m.types.size() > 1)
+        throw InputError(where, key, "the model has several types; edit the model file instead");
+      fx.size_distribution = false;
+    }
+    return;
+  }
+  auto partners_default = [&](double Interaction::*field, bool with_pill) {
+    std::map<std::string, double> v;
+    for (const auto& n : lib.names())
+      if ((n != "pill" || with_pill) && lib.has_interaction("pill", n))
+        v[n] = lib.interaction("pill", n).*field;
+    return v;
+  };
+  auto set_partner = [&](std::optional<std::map<std::string, double>>& slot,
+                         double Interaction::*field, bool with_pill, double lo, double hi) {
+    if (!slot) slot = partners_default(field, with_pill);
+    if (value == "on") return;
+    const double x = parse_number(value, where, key, lo, hi);
+    if (partner.empty()) {
+      for (auto& [k, v] : *slot) v = x;
+    } else {
+      if (!slot->count(partner))
+        throw InputError(where, key, "no partner material '" + partner + "'");
+      (*slot)[partner] = x;
+    }
+  };
+  if (name == "rolling_friction") {
+    set_partner(fx.rolling_friction, &Interaction::rolling_friction, true, 0.0, 10.0);
+  } else if (name == "wall_friction") {
+    set_partner(fx.wall_friction, &Interaction::static_friction, false, 0.0, 10.0);
+  } else if (name == "restitution") {
+    set_partner(fx.restitution, &Interaction::restitution, true, 1e-6, 1.0);
+  } else if (name == "particle_friction") {
+    fx.particle_friction = value == "on" ? lib.interaction("pill", "pill").static_friction
+                                         : parse_number(value, where, key, 0.0, 10.0);
+  } else if (name == "cohesion") {
+    fx.cohesion = parse_quantity(value, Dimension::Pressure, where, key);
+  } else if (name == "shape_resolution") {
+    fx.shape_resolution = int(parse_number(value, where, key, 1, 1000));
+  } else if (name == "size_distribution") {
+    fx.size_distribution = true;
+  } else if (name == "rolling_model") {
+    if (!fx.rolling_friction)
+      throw InputError(where, key, "a rolling model needs rolling_friction on");
+    fx.rolling_model = dem::rolling_model_from_string(value, where, key);
+  }
+}
+
+}  // namespace clumpkit

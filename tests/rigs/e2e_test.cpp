@@ -1,0 +1,76 @@
+// Each rig end to end through the real DEM engine at the mini scale (reduced further where a
+// setting allows), asserting physical outcomes, and checkpoint/resume of finished repeats.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <numbers>
+
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/rigs/rig.hpp"
+
+namespace clumpkit::rigs {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kModels = fs::path(CLUMPKIT_SOURCE_DIR) / "shapes" / "models";
+
+RigRequest request(const std::string& rig, const std::string& settings, const std::string& out) {
+  RigRequest r;
+  r.rig = rig;
+  r.model = load_model(kModels / "production.toml");
+  r.settings = parse_settings(find_rig(rig), settings, "test");
+  r.threads = 2;
+  r.rays = 3000;
+  r.out = fs::path(CLUMPKIT_BINARY_DIR) / "tests" / "rigs" / out;
+  fs::remove_all(r.out);
+  return r;
+}
+
+TEST(RigEndToEnd, BulkDensityOfTheProductionMix) {
+  const RigResult r = run_rig(request("bulk_density", "scale=mini", "e2e_bulk"));
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  ASSERT_EQ(r.repeats.size(), 1u);
+  const double rho = r.stats.at("bulk_density").mean;
+  EXPECT_GT(rho, 500.0);
+  EXPECT_LT(rho, 900.0);
+  EXPECT_TRUE(r.repeats[0].details.at("overflowed").get<bool>());
+  EXPECT_TRUE(fs::exists(r.repeats.empty() ? fs::path()
+                                           : fs::path(CLUMPKIT_BINARY_DIR) / "tests" / "rigs" /
+                                                 "e2e_bulk" / "repeat_1" / "result.json"));
+}
+
+TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
+  const RigResult r = run_rig(request("angle_of_repose", "scale=mini", "e2e_aor"));
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  const double deg = 180.0 / std::numbers::pi;
+  const double a = r.stats.at("angle").mean * deg;
+  EXPECT_GT(a, 10.0);
+  EXPECT_LT(a, 45.0);
+  EXPECT_NEAR(r.stats.at("angle_left").mean * deg, a, 8.0);
+  const fs::path dir = fs::path(CLUMPKIT_BINARY_DIR) / "tests" / "rigs" / "e2e_aor" / "repeat_1";
+  EXPECT_TRUE(fs::exists(dir / "heap.png"));
+  // A rerun keeps the finished repeat instead of simulating again.
+  RigRequest again = request("angle_of_repose", "scale=mini", "e2e_aor_again");
+  again.out = dir.parent_path();
+  const RigResult r2 = run_rig(again);
+  ASSERT_EQ(r2.repeats.size(), 1u);
+  EXPECT_TRUE(r2.repeats[0].resumed);
+  EXPECT_DOUBLE_EQ(r2.stats.at("angle").mean, r.stats.at("angle").mean);
+}
+
+TEST(RigEndToEnd, DischargeFillsThePockets) {
+  const RigResult r = run_rig(request("discharge", "scale=mini;rpm=30;pockets=2", "e2e_discharge"));
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  const double m = r.stats.at("pocket_mass").mean;
+  EXPECT_GT(m, 0.0);
+  EXPECT_LT(r.stats.at("pocket_mass_cv").mean, 0.5);
+  // Steady flow = pocket mass × 8 pockets × rpm / 60.
+  EXPECT_NEAR(r.stats.at("mass_flow").mean, m * 8 * 30 / 60.0, 1e-12);
+}
+
+TEST(RigEndToEnd, ScaleThatCannotHoldTheMassIsRefused) {
+  EXPECT_THROW(run_rig(request("angle_of_repose", "scale=mini;mass=2", "e2e_refused")), InputError);
+}
+
+}  // namespace
+}  // namespace clumpkit::rigs

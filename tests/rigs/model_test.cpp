@@ -1,0 +1,161 @@
+// Particle model files: the bundled models load, effects map onto the DEM contact laws (absent =
+// absent), the mass basis scales mass and inertia, and bad files name file:line and key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/rigs/model.hpp"
+
+namespace clumpkit {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kModels = fs::path(CLUMPKIT_SOURCE_DIR) / "shapes" / "models";
+
+// A model file in the models folder (so "../pill_A.toml" resolves), parsed from text.
+ParticleModel parse(const std::string& text) {
+  return parse_model(text, kModels / "test_model.toml", fs::path(CLUMPKIT_SOURCE_DIR));
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kHead = R"(
+[model]
+name = "t"
+materials = "../materials.toml"
+[[types]]
+name = "A"
+shape = "../pill_A.toml"
+paper_spheres = 12
+)";
+
+TEST(Model, BundledPaperVariantsAndProductionLoad) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(kModels)) {
+    if (e.path().extension() != ".toml") continue;
+    const ParticleModel m = load_model(e.path());
+    EXPECT_FALSE(m.types.empty()) << e.path();
+    EXPECT_TRUE(m.effects.on("rolling_friction"));
+    EXPECT_FALSE(m.effects.on("cohesion"));
+    ++n;
+  }
+  EXPECT_EQ(n, 10);  // nine single-type variants and the production model
+  const ParticleModel p = load_model(kModels / "production.toml");
+  ASSERT_EQ(p.types.size(), 3u);
+  EXPECT_NEAR(p.types[0].mass_fraction, 0.35, 1e-12);
+  EXPECT_NEAR(p.types[2].mass_fraction, 0.30, 1e-12);
+  EXPECT_TRUE(p.effects.size_distribution);
+  const auto mix = p.mixture();
+  EXPECT_EQ(mix[1].clump_type, "B");
+}
+
+TEST(Model, EffectsMapToPairLawsAndAbsentMeansAbsent) {
+  ParticleModel m = parse(std::string(kHead) + R"(
+[effects]
+restitution = true
+wall_friction = true
+[effects.rolling_friction]
+pill = 0.1
+)");
+  const auto laws = m.pair_contacts({"abs_plastic"});
+  ASSERT_EQ(laws.size(), 2u);
+  const auto& pp = laws[0].law;                  // pill-pill
+  EXPECT_FALSE(pp.static_friction.has_value());  // particle_friction absent
+  ASSERT_TRUE(pp.rolling.has_value());
+  EXPECT_DOUBLE_EQ(pp.rolling->coefficient, 0.1);
+  EXPECT_DOUBLE_EQ(*pp.restitution, 0.201);  // Table 1
+  const auto& pw = laws[1].law;              // pill-ABS
+  EXPECT_DOUBLE_EQ(*pw.static_friction, 0.577);
+  EXPECT_DOUBLE_EQ(pw.rolling->coefficient, 0.120);  // not given: the library's value
+  EXPECT_FALSE(pw.cohesion.has_value());
+
+  set_model_effect(m, "effects.rolling_friction", "off", "--set");
+  set_model_effect(m, "effects.cohesion", "2e4 J/m^3", "--set");
+  set_model_effect(m, "effects.particle_friction", "0.3", "--set");
+  const auto laws2 = m.pair_contacts({"abs_plastic"});
+  EXPECT_FALSE(laws2[0].law.rolling.has_value());
+  EXPECT_DOUBLE_EQ(laws2[0].law.cohesion->energy_density, 2e4);
+  EXPECT_DOUBLE_EQ(*laws2[0].law.static_friction, 0.3);
+  EXPECT_FALSE(laws2[1].law.cohesion.has_value());  // cohesion is pill-pill
+  EXPECT_THROW(set_model_effect(m, "effects.stickiness", "1", "--set"), InputError);
+  EXPECT_THROW(set_model_effect(m, "effects.restitution", "1.5", "--set"), InputError);
+}
+
+TEST(Model, MassBasisScalesMassAndInertiaTogether) {
+  const ParticleModel u = parse(std::string(kHead) + "[effects]\nrestitution = true\n");
+  std::string text = std::string(kHead) + "[effects]\nrestitution = true\n";
+  text.replace(text.find("name = \"t\""), 10, "name = \"t\"\nmass_basis = \"true_shape\"");
+  const ParticleModel t = parse(text);
+  const auto cu = u.clump_types(4000), ct = t.clump_types(4000);
+  const double cyl = 1380.0 * M_PI * 0.25 * 0.006 * 0.006 * 0.0054;
+  EXPECT_NEAR(ct[0].clump.mass.mass, cyl, 1e-12);
+  EXPECT_LT(cu[0].clump.mass.mass, 0.9 * cyl);  // the union is lighter than the cylinder
+  const double f = ct[0].clump.mass.mass / cu[0].clump.mass.mass;
+  EXPECT_NEAR(ct[0].clump.mass.principal_moments[2] / cu[0].clump.mass.principal_moments[2], f,
+              1e-9);
+}
+
+TEST(Model, ErrorsNameFileLineAndKey) {
+  std::string e = error_of(std::string(kHead) + "[effects]\nstickiness = true\n");
+  EXPECT_NE(e.find("test_model.toml"), std::string::npos) << e;
+  EXPECT_NE(e.find("effects.stickiness"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown effect"), std::string::npos) << e;
+
+  e = error_of(std::string(kHead) + "[effects.rolling_friction]\npill = -0.1\n");
+  EXPECT_NE(e.find("test_model.toml:11"), std::string::npos) << e;
+  EXPECT_NE(e.find("effects.rolling_friction.pill"), std::string::npos) << e;
+
+  e = error_of(std::string(kHead) + "[effects.wall_friction]\nunobtainium = 0.3\n");
+  EXPECT_NE(e.find("unobtainium"), std::string::npos) << e;
+
+  e = error_of(R"(
+[model]
+mass_basis = "weighed"
+[[types]]
+name = "A"
+shape = "../pill_A.toml"
+paper_spheres = 12
+)");
+  EXPECT_NE(e.find("test_model.toml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("model.mass_basis"), std::string::npos) << e;
+
+  e = error_of(R"(
+[[types]]
+name = "A"
+shape = "../pill_A.toml"
+)");
+  EXPECT_NE(e.find("paper_spheres"), std::string::npos) << e;
+
+  e = error_of(R"(
+[[types]]
+name = "A"
+shape = "../no_such_pill.toml"
+paper_spheres = 12
+)");
+  EXPECT_NE(e.find("types.0.shape"), std::string::npos) << e;
+  EXPECT_NE(e.find("not found"), std::string::npos) << e;
+
+  // Two types without size_distribution: the population would silently have one size.
+  e = error_of(std::string(kHead) + R"(
+[[types]]
+name = "B"
+shape = "../pill_B.toml"
+paper_spheres = 12
+)");
+  EXPECT_NE(e.find("size_distribution"), std::string::npos) << e;
+
+  e = error_of("[modle]\nname = \"x\"\n");
+  EXPECT_NE(e.find("modle"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace clumpkit
