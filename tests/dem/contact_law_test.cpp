@@ -142,8 +142,8 @@ std::pair<double, double> head_on(double e, double speed, bool with_wall) {
     if (touching && t_on < 0.0) t_on = w.time();
     if (!touching && t_on >= 0.0) t_off = w.time();
   }
-  const double v_out = with_wall ? w.velocities()[0].z()
-                                 : w.velocities()[1].z() - w.velocities()[0].z();
+  const double v_out =
+      with_wall ? w.velocities()[0].z() : w.velocities()[1].z() - w.velocities()[0].z();
   return {v_out / speed, t_off - t_on};
 }
 

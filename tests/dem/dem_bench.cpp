@@ -39,8 +39,11 @@ int main(int argc, char** argv) {
   // Cup: 300 pills fill about 2/3 of it; larger pours scale it in proportion.
   const double scale = std::cbrt(std::max(1.0, pills / 300.0));
   const double cup_r = 0.025 * scale, cup_h = 0.06 * scale;
-  s.walls.push_back({"cup", dem::make_cylinder(Eigen::Vector3d::Zero(), cup_r, cup_h, 48, true, false),
-                     "organic_glass", {}, {}});
+  s.walls.push_back({"cup",
+                     dem::make_cylinder(Eigen::Vector3d::Zero(), cup_r, cup_h, 48, true, false),
+                     "organic_glass",
+                     {},
+                     {}});
   f.name = "pour";
   f.region = dem::CylinderRegion{Eigen::Vector3d(0, 0, cup_h + 0.005), cup_r * 0.9, 0.03};
   f.count = pills;
@@ -65,7 +68,8 @@ int main(int argc, char** argv) {
   std::printf("%ld steps in %.2f s: %.3g sphere-steps/s, %.3g clump-steps/s\n", w.step_count(),
               wall, sphere_steps / wall, clump_steps / wall);
   std::printf("%d pills, %ld spheres; contacts %d, kinetic energy %.3g J, state hash %016llx\n",
-              w.clump_count(), w.sphere_count(), w.contact_count(), w.kinetic_energy(), static_cast<unsigned long long>(w.state_hash()));
+              w.clump_count(), w.sphere_count(), w.contact_count(), w.kinetic_energy(),
+              static_cast<unsigned long long>(w.state_hash()));
   std::printf("%s", w.profile().table().c_str());
   return 0;
 }

@@ -105,10 +105,10 @@ TEST(Dynamics, RollingResistanceStopsButNeverReverses) {
 // Free rigid body: spin about the intermediate axis is unstable (Dzhanibekov effect), spin
 // about the major axis is stable; |L| in the world frame and the energy are conserved.
 struct SpinResult {
-  double max_perp = 0.0;   // largest |ω1| seen, relative to the spin
-  bool flipped = false;    // ω2 changed sign
-  double l_drift = 0.0;    // relative change of the world angular momentum
-  double e_drift = 0.0;    // relative change of the kinetic energy
+  double max_perp = 0.0;  // largest |ω1| seen, relative to the spin
+  bool flipped = false;   // ω2 changed sign
+  double l_drift = 0.0;   // relative change of the world angular momentum
+  double e_drift = 0.0;   // relative change of the kinetic energy
 };
 
 SpinResult spin(int axis) {
@@ -159,12 +159,15 @@ TEST(Dynamics, EnergyConservedWithoutDampingAndFriction) {
   s.pair_contacts.push_back({"pill", "pill", elastic});
   s.pair_contacts.push_back({"pill", "galvanized_steel", elastic});
   const double r = 2e-3;
-  s.clump_types.push_back(test::clump_type(
-      "dumbbell", {{Eigen::Vector3d(-r, 0, 0), r}, {Eigen::Vector3d(r, 0, 0), r}},
-      2.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r * 1380.0,
-      Eigen::Vector3d(1.0e-10, 4.0e-10, 4.0e-10)));
-  s.walls.push_back({"box", make_box(Eigen::Vector3d(-0.01, -0.01, 0), Eigen::Vector3d(0.01, 0.01, 0.02)),
-                     "galvanized_steel", {}, {}});
+  s.clump_types.push_back(
+      test::clump_type("dumbbell", {{Eigen::Vector3d(-r, 0, 0), r}, {Eigen::Vector3d(r, 0, 0), r}},
+                       2.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r * 1380.0,
+                       Eigen::Vector3d(1.0e-10, 4.0e-10, 4.0e-10)));
+  s.walls.push_back({"box",
+                     make_box(Eigen::Vector3d(-0.01, -0.01, 0), Eigen::Vector3d(0.01, 0.01, 0.02)),
+                     "galvanized_steel",
+                     {},
+                     {}});
   // Velocity Verlet's energy error is O(dt²) while springs are loaded (measured: largest
   // deviation 1.4e-4 at 0.1 T_R, 3.7e-5 at 0.05 T_R, 8e-6 at 0.025 T_R); 1e-6 needs 0.02 T_R.
   s.time_step = 0.02 * rayleigh_time(r, 1380.0, 1.1e8 / 2.7, 0.35);
@@ -173,10 +176,11 @@ TEST(Dynamics, EnergyConservedWithoutDampingAndFriction) {
   for (int k = 0; k < 8; ++k) {
     const double x = (k & 1) ? 4.5e-3 : -4.5e-3, y = (k & 2) ? 4.5e-3 : -4.5e-3;
     const double z = (k & 4) ? 14.5e-3 : 5e-3;
-    w.add_clump(0, Eigen::Vector3d(x, y, z),
-                Eigen::Quaterniond(Eigen::AngleAxisd(0.7 * k, Eigen::Vector3d(1, 2, 3).normalized())),
-                Eigen::Vector3d(0.1 * (k % 3) - 0.1, 0.2 - 0.05 * k, 0.1),
-                Eigen::Vector3d(5.0 * k, -3.0, 2.0));
+    w.add_clump(
+        0, Eigen::Vector3d(x, y, z),
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.7 * k, Eigen::Vector3d(1, 2, 3).normalized())),
+        Eigen::Vector3d(0.1 * (k % 3) - 0.1, 0.2 - 0.05 * k, 0.1),
+        Eigen::Vector3d(5.0 * k, -3.0, 2.0));
   }
   w.step();
   const double e0 = w.kinetic_energy() + w.potential_energy() + w.elastic_energy();

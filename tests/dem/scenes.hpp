@@ -22,8 +22,8 @@ inline ClumpTypeSettings sphere_type(const std::string& name, double radius, dou
 
 /// A clump from spheres with given (not sampled) mass and principal moments, in its
 /// principal frame. For tests that need a rigid body of known inertia.
-inline ClumpTypeSettings clump_type(const std::string& name, const Spheres& spheres,
-                                    double mass, const Eigen::Vector3d& moments,
+inline ClumpTypeSettings clump_type(const std::string& name, const Spheres& spheres, double mass,
+                                    const Eigen::Vector3d& moments,
                                     const std::string& material = "pill") {
   ClumpTypeSettings t;
   t.name = name;

@@ -72,8 +72,11 @@ TEST(Walls, ConvexEdgeGivesOneContactConcaveCornerGivesThree) {
   s.materials = test::test_materials(0.5, 0.5, 0.05);
   const double r = 2e-3;
   s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
-  WallSettings block{"block", make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.01, 0.01, 0.01)),
-                     "galvanized_steel", {}, {}};
+  WallSettings block{"block",
+                     make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.01, 0.01, 0.01)),
+                     "galvanized_steel",
+                     {},
+                     {}};
   s.walls.push_back(block);
   World w = World::create(s);
   // Outside, over the top corner vertex (0, 0, 0.01), touching it diagonally.
@@ -91,8 +94,11 @@ TEST(Walls, ConvexEdgeGivesOneContactConcaveCornerGivesThree) {
 
   // Inside a closed box, in a corner: floor and two side walls.
   WorldSettings s2 = s;
-  s2.walls = {{"box", make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.02, 0.02, 0.02)),
-               "galvanized_steel", {}, {}}};
+  s2.walls = {{"box",
+               make_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.02, 0.02, 0.02)),
+               "galvanized_steel",
+               {},
+               {}}};
   World w2 = World::create(s2);
   w2.add_clump(0, Eigen::Vector3d(r - 1e-6, r - 1e-6, r - 1e-6));
   w2.step();
@@ -113,7 +119,8 @@ TEST(Walls, WallRecordsForceAndTorque) {
   EXPECT_NEAR(ws.force.z(), -mg, 1e-4 * mg);
   EXPECT_NEAR(ws.force.head<2>().norm(), 0.0, 1e-6 * mg);
   // Torque about the origin of the weight carried at (0.01, −0.02): r × F.
-  const Eigen::Vector3d expected = Eigen::Vector3d(0.01, -0.02, 0).cross(Eigen::Vector3d(0, 0, -mg));
+  const Eigen::Vector3d expected =
+      Eigen::Vector3d(0.01, -0.02, 0).cross(Eigen::Vector3d(0, 0, -mg));
   EXPECT_NEAR((ws.torque - expected).norm(), 0.0, 1e-4 * expected.norm());
 }
 
@@ -158,7 +165,8 @@ TEST(Walls, BadMeshIsAnInputError) {
   s.source = "scene.toml";
   s.clump_types.push_back(test::sphere_type("ball", 2e-3, 1380.0));
   WallSettings bad{"cup", {}, "organic_glass", {}, {}};
-  bad.mesh.vertices = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2, 0, 0)};
+  bad.mesh.vertices = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
+                       Eigen::Vector3d(2, 0, 0)};
   bad.mesh.triangles = {{0, 1, 2}};
   s.walls.push_back(bad);
   try {

@@ -17,9 +17,10 @@ ClumpTypeSettings pill4(const std::string& name, double r, double h) {
   for (int k = 0; k < 4; ++k)
     s.push_back({Eigen::Vector3d((k & 1) ? r : -r, 0.0, (k & 2) ? h : -h), r});
   const double m = 4.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r * 1380.0;
-  return test::clump_type(name, s, m,
-                          Eigen::Vector3d(m * (h * h + 0.4 * r * r), m * (r * r + h * h + 0.4 * r * r),
-                                          m * (r * r + 0.4 * r * r)));
+  return test::clump_type(
+      name, s, m,
+      Eigen::Vector3d(m * (h * h + 0.4 * r * r), m * (r * r + h * h + 0.4 * r * r),
+                      m * (r * r + 0.4 * r * r)));
 }
 
 // A pour of a few hundred 4-sphere pills from a box factory into an open-topped box.
@@ -29,7 +30,8 @@ WorldSettings pour(int threads, std::uint64_t seed = 7) {
   s.threads = threads;
   s.seed = seed;
   s.clump_types = {pill4("A", 1.0e-3, 0.6e-3), pill4("B", 1.0e-3, 0.9e-3)};
-  TriangleMesh cup = make_box(Eigen::Vector3d(-0.012, -0.012, 0), Eigen::Vector3d(0.012, 0.012, 0.06));
+  TriangleMesh cup =
+      make_box(Eigen::Vector3d(-0.012, -0.012, 0), Eigen::Vector3d(0.012, 0.012, 0.06));
   s.walls.push_back({"cup", cup, "organic_glass", {}, {}});
   FactorySettings f;
   f.name = "hopper";
@@ -116,7 +118,8 @@ TEST(World, FactoryReportsARegionTooSmall) {
 TEST(World, FactoryMixtureByMassAndRate) {
   WorldSettings s = pour(1);
   FactorySettings& f = s.factories[0];
-  f.region = BoxRegion{Eigen::Vector3d(-0.011, -0.011, 0.025), Eigen::Vector3d(0.011, 0.011, 0.055)};
+  f.region =
+      BoxRegion{Eigen::Vector3d(-0.011, -0.011, 0.025), Eigen::Vector3d(0.011, 0.011, 0.055)};
   f.velocity = Eigen::Vector3d(0, 0, -0.5);
   f.count.reset();
   const double ma = 4.0 * 4.0 / 3.0 * std::numbers::pi * 1e-9 * 1380.0;  // mass of one pill

@@ -151,8 +151,8 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   for (int t : types) {
     if (t < 0 || t >= static_cast<int>(w.types.size()))
       throw InputError(path.string(), "", "checkpoint is corrupt (clump type)");
-    w.add_clump(t, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(),
-                Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    w.add_clump(t, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
+                Eigen::Vector3d::Zero());
   }
   in.vec(w.c_x);
   in.vec(w.c_v);

@@ -14,9 +14,12 @@ const double kDampingFactor = 2.0 * std::sqrt(5.0 / 6.0);
 
 const char* to_string(RollingModel m) {
   switch (m) {
-    case RollingModel::kStandard: return "standard";
-    case RollingModel::kCdt: return "cdt";
-    case RollingModel::kEpsd: return "epsd";
+    case RollingModel::kStandard:
+      return "standard";
+    case RollingModel::kCdt:
+      return "cdt";
+    case RollingModel::kEpsd:
+      return "epsd";
   }
   return "?";
 }
@@ -26,8 +29,7 @@ RollingModel rolling_model_from_string(const std::string& s, const std::string& 
   if (s == "standard") return RollingModel::kStandard;
   if (s == "cdt") return RollingModel::kCdt;
   if (s == "epsd") return RollingModel::kEpsd;
-  throw InputError(where, field,
-                   "unknown rolling model '" + s + "' (known: standard, cdt, epsd)");
+  throw InputError(where, field, "unknown rolling model '" + s + "' (known: standard, cdt, epsd)");
 }
 
 PairContact PairContact::from(const Interaction& i, RollingModel model) {

@@ -42,8 +42,7 @@ Eigen::Quaterniond random_rotation(std::mt19937_64& rng) {
   const double u1 = uniform(rng), u2 = uniform(rng), u3 = uniform(rng);
   const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
   const double t2 = 2.0 * std::numbers::pi * u2, t3 = 2.0 * std::numbers::pi * u3;
-  return Eigen::Quaterniond(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2),
-                            b * std::sin(t3));
+  return Eigen::Quaterniond(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
 }
 
 // A centre of mass at which a clump of bounding radius `bound` lies inside the region.
@@ -159,7 +158,8 @@ void World::Impl::run_factories() {
     long placed = 0;
     bool stuck = false, reached = false;
     while (true) {
-      const double have = by_count ? static_cast<double>(f.status.inserted) : f.status.inserted_mass;
+      const double have =
+          by_count ? static_cast<double>(f.status.inserted) : f.status.inserted_mass;
       // Mixture: the entry furthest below its mass share gets the next clump.
       int pick = 0;
       double best = -std::numeric_limits<double>::infinity();
@@ -196,8 +196,8 @@ void World::Impl::run_factories() {
         }
         for (size_t k = 0; k < td.radii.size(); ++k) grid.add(x + R * td.offsets[k], td.radii[k]);
         add_clump(type, x, q, f.s.velocity, Eigen::Vector3d::Zero());
-        batch_energy += 0.5 * td.mass * f.s.velocity.squaredNorm() -
-                        td.mass * settings.gravity.dot(x);
+        batch_energy +=
+            0.5 * td.mass * f.s.velocity.squaredNorm() - td.mass * settings.gravity.dot(x);
         ++f.status.inserted;
         f.status.inserted_mass += td.mass;
         f.type_mass[pick] += td.mass;

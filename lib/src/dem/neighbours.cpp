@@ -56,7 +56,7 @@ void World::Impl::rebuild_neighbours() {
   // Spheres sorted by cell.
   std::vector<std::pair<std::uint64_t, int>> bins(ns);
   std::vector<std::array<std::int64_t, 3>> sc(ns);
-#pragma omp parallel for num_threads(threads) schedule(static) if(ns >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     sc[s] = {cell_of(s_pos[s].x(), h), cell_of(s_pos[s].y(), h), cell_of(s_pos[s].z(), h)};
     bins[s] = {cell_key(sc[s][0], sc[s][1], sc[s][2]), s};
@@ -71,7 +71,7 @@ void World::Impl::rebuild_neighbours() {
 
   // Sphere pairs, per sphere i the sorted list of j > i.
   std::vector<std::vector<int>> near(ns);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int i = 0; i < ns; ++i) {
     auto& out = near[i];
     for (int dx = -1; dx <= 1; ++dx)
@@ -94,8 +94,8 @@ void World::Impl::rebuild_neighbours() {
   std::vector<ContactHistory> next_hist(next.size());
   size_t a = 0;
   for (size_t k = 0; k < next.size(); ++k) {
-    while (a < pairs.size() && (pairs[a].i < next[k].i ||
-                                (pairs[a].i == next[k].i && pairs[a].j < next[k].j)))
+    while (a < pairs.size() &&
+           (pairs[a].i < next[k].i || (pairs[a].i == next[k].i && pairs[a].j < next[k].j)))
       ++a;
     if (a < pairs.size() && pairs[a].i == next[k].i && pairs[a].j == next[k].j)
       next_hist[k] = pair_hist[a];
@@ -114,8 +114,10 @@ void World::Impl::rebuild_neighbours() {
     const WallData& wd = walls[wi];
     for (size_t ti = 0; ti < wd.triangles.size(); ++ti) {
       const auto& t = wd.triangles[ti];
-      Eigen::Vector3d lo = wd.vertices[t[0]].cwiseMin(wd.vertices[t[1]]).cwiseMin(wd.vertices[t[2]]);
-      Eigen::Vector3d hi = wd.vertices[t[0]].cwiseMax(wd.vertices[t[1]]).cwiseMax(wd.vertices[t[2]]);
+      Eigen::Vector3d lo =
+          wd.vertices[t[0]].cwiseMin(wd.vertices[t[1]]).cwiseMin(wd.vertices[t[2]]);
+      Eigen::Vector3d hi =
+          wd.vertices[t[0]].cwiseMax(wd.vertices[t[1]]).cwiseMax(wd.vertices[t[2]]);
       lo.array() -= grow;
       hi.array() += grow;
       const std::int64_t x0 = cell_of(lo.x(), h), x1 = cell_of(hi.x(), h);
@@ -130,7 +132,7 @@ void World::Impl::rebuild_neighbours() {
   if (walls_moved) std::sort(tri_bins.begin(), tri_bins.end());
   tri_bins_valid = true;
   std::vector<std::vector<std::array<int, 2>>> cand(ns);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     const std::uint64_t key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
     auto lo = std::lower_bound(tri_bins.begin(), tri_bins.end(),

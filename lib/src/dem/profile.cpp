@@ -23,8 +23,7 @@ std::string Profile::table() const {
   row("output", output);
   row("total", tot);
   char buf[96];
-  std::snprintf(buf, sizeof buf, "steps %ld, neighbour rebuilds %ld\n", steps,
-                neighbour_rebuilds);
+  std::snprintf(buf, sizeof buf, "steps %ld, neighbour rebuilds %ld\n", steps, neighbour_rebuilds);
   s += buf;
   return s;
 }

@@ -84,9 +84,9 @@ void World::Impl::ensure_forces() {
 
 void World::Impl::update_spheres(int first_clump) {
   const int n0 = first_clump < static_cast<int>(c_first.size()) ? c_first[first_clump]
-                                                                 : static_cast<int>(s_r.size());
+                                                                : static_cast<int>(s_r.size());
   const int ns = static_cast<int>(s_r.size());
-#pragma omp parallel for num_threads(threads) schedule(static) if(ns - n0 >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (ns - n0 >= kParallelMin)
   for (int s = n0; s < ns; ++s) {
     const int c = s_clump[s];
     s_pos[s] = c_x[c] + c_R[c] * s_off[s];
@@ -118,7 +118,7 @@ static inline void half_kick(World::Impl& w, int c, double h) {
 void World::Impl::kick_and_drift() {
   const int nc = static_cast<int>(c_x.size());
   const double h = 0.5 * dt;
-#pragma omp parallel for num_threads(threads) schedule(static) if(nc >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (nc >= kParallelMin)
   for (int c = 0; c < nc; ++c) {
     half_kick(*this, c, h);
     c_x[c] += dt * c_v[c];
@@ -146,7 +146,7 @@ void World::Impl::kick_and_drift() {
 void World::Impl::kick() {
   const int nc = static_cast<int>(c_x.size());
   const double h = 0.5 * dt;
-#pragma omp parallel for num_threads(threads) schedule(static) if(nc >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (nc >= kParallelMin)
   for (int c = 0; c < nc; ++c) half_kick(*this, c, h);
 }
 
@@ -164,7 +164,9 @@ void World::Impl::move_walls() {
 void World::Impl::update_neighbours() {
   const int ns = static_cast<int>(s_r.size());
   double ds = 0.0;
-#pragma omp parallel for num_threads(threads) schedule(static) reduction(max : ds) if(ns >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) \
+    reduction(max                                              \
+              : ds) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
   ds = std::sqrt(ds);
   double dw = 0.0;
@@ -182,7 +184,7 @@ void World::Impl::detect_contacts() {
   // Sphere pairs: flag in parallel, compact in order.
   const int np = static_cast<int>(pairs.size());
   std::vector<double> dist(np);
-#pragma omp parallel for num_threads(threads) schedule(static) if(np >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (np >= kParallelMin)
   for (int k = 0; k < np; ++k) {
     const PairEntry& p = pairs[k];
     const double rr = s_r[p.i] + s_r[p.j];
@@ -203,14 +205,13 @@ void World::Impl::detect_contacts() {
     pc.pair = k;
     const double d = dist[k];
     pc.overlap = s_r[p.i] + s_r[p.j] - d;
-    pc.normal = d > 0.0 ? Eigen::Vector3d((s_pos[p.i] - s_pos[p.j]) / d)
-                        : Eigen::Vector3d::UnitZ();
+    pc.normal = d > 0.0 ? Eigen::Vector3d((s_pos[p.i] - s_pos[p.j]) / d) : Eigen::Vector3d::UnitZ();
     pc.point = s_pos[p.i] - (s_r[p.i] - 0.5 * pc.overlap) * pc.normal;
     const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
     if (ratio > max_overlap_ratio) {
       max_overlap_ratio = ratio;
-      max_overlap_what = "clumps " + std::to_string(s_clump[p.i]) + " and " +
-                         std::to_string(s_clump[p.j]);
+      max_overlap_what =
+          "clumps " + std::to_string(s_clump[p.i]) + " and " + std::to_string(s_clump[p.j]);
     }
     pair_contacts.push_back(pc);
   }
@@ -224,7 +225,7 @@ void World::Impl::detect_contacts() {
   const double merge_cos = std::cos(10.0 * 3.14159265358979323846 / 180.0);
   std::vector<double> ratio_s(ns, 0.0);
   std::vector<int> overflow(ns, 0);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if(ns >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     struct Cand {
       double dist;
@@ -239,8 +240,8 @@ void World::Impl::detect_contacts() {
       const auto [wi, ti] = wall_cand[k];
       const WallData& wd = walls[wi];
       const auto& tri = wd.triangles[ti];
-      const Eigen::Vector3d c =
-          closest_point_on_triangle(p, wd.vertices[tri[0]], wd.vertices[tri[1]], wd.vertices[tri[2]]);
+      const Eigen::Vector3d c = closest_point_on_triangle(p, wd.vertices[tri[0]],
+                                                          wd.vertices[tri[1]], wd.vertices[tri[2]]);
       const double d = (p - c).norm();
       if (d < r) cands[nc++] = {d, wi, ti, c};
     }
@@ -323,11 +324,11 @@ void World::Impl::detect_contacts() {
 void World::Impl::compute_forces(double hdt) {
   const int nc = static_cast<int>(c_x.size());
   c_ww.resize(nc);
-#pragma omp parallel for num_threads(threads) schedule(static) if(nc >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (nc >= kParallelMin)
   for (int c = 0; c < nc; ++c) c_ww[c] = c_R[c] * c_wb[c];
 
   const int npc = static_cast<int>(pair_contacts.size());
-#pragma omp parallel for num_threads(threads) schedule(static) if(npc >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(static) if (npc >= kParallelMin)
   for (int k = 0; k < npc; ++k) {
     PairContactData& pc = pair_contacts[k];
     const PairEntry& p = pairs[pc.pair];
@@ -349,7 +350,7 @@ void World::Impl::compute_forces(double hdt) {
   }
 
   const int ns = static_cast<int>(s_r.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if(ns >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     const int n = wall_contact_n[s];
     if (n == 0) continue;
@@ -422,8 +423,8 @@ void World::Impl::compute_forces(double hdt) {
 
 void World::Impl::check_health() {
   auto fail = [&](const std::string& what) {
-    throw NumericalError("step " + std::to_string(steps) + ", t = " + fmt_g(time) +
-                         " s: " + what + " (time step " + fmt_g(dt) + " s)");
+    throw NumericalError("step " + std::to_string(steps) + ", t = " + fmt_g(time) + " s: " + what +
+                         " (time step " + fmt_g(dt) + " s)");
   };
   if (max_overlap_ratio > 0.5)
     fail("overlap of " + fmt_g(100.0 * max_overlap_ratio) + " % of a sphere radius between " +
@@ -434,7 +435,8 @@ void World::Impl::check_health() {
   const int nc = static_cast<int>(c_x.size());
   for (int c = 0; c < nc; ++c) {
     if (!c_x[c].allFinite() || !c_v[c].allFinite() || !c_wb[c].allFinite())
-      fail("clump " + std::to_string(c) + " has a non-finite position or velocity: the run blew up");
+      fail("clump " + std::to_string(c) +
+           " has a non-finite position or velocity: the run blew up");
     if (c_v[c].norm() > settings.max_speed)
       fail("clump " + std::to_string(c) + " moves at " + fmt_g(c_v[c].norm()) +
            " m/s, above max_speed " + fmt_g(settings.max_speed) + " m/s: the run blew up");

@@ -21,9 +21,9 @@ void TriangleMesh::validate(const std::string& where, const std::string& field) 
     const auto& tri = triangles[t];
     for (int k = 0; k < 3; ++k)
       if (tri[k] < 0 || tri[k] >= n)
-        throw InputError(where, field + ".triangles[" + std::to_string(t) + "]",
-                         "vertex index " + std::to_string(tri[k]) + " is outside 0.." +
-                             std::to_string(n - 1));
+        throw InputError(
+            where, field + ".triangles[" + std::to_string(t) + "]",
+            "vertex index " + std::to_string(tri[k]) + " is outside 0.." + std::to_string(n - 1));
     const Eigen::Vector3d e1 = vertices[tri[1]] - vertices[tri[0]];
     const Eigen::Vector3d e2 = vertices[tri[2]] - vertices[tri[0]];
     const double scale = std::max(e1.squaredNorm(), e2.squaredNorm());
@@ -80,7 +80,9 @@ void VelocityProfile::validate(const std::string& where, const std::string& fiel
   }
 }
 
-double WallRotation::angular_speed() const { return rpm * 2.0 * std::numbers::pi / 60.0; }
+double WallRotation::angular_speed() const {
+  return rpm * 2.0 * std::numbers::pi / 60.0;
+}
 
 double WallRotation::angle(double t) const {
   const double span = std::clamp(t, start_time, std::max(start_time, stop_time)) - start_time;
@@ -104,8 +106,8 @@ WallPose wall_pose(const WallMotion& motion, double t) {
   return p;
 }
 
-TriangleMesh make_plane(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
-                        double size_u, double size_v, int divisions) {
+TriangleMesh make_plane(const Eigen::Vector3d& center, const Eigen::Vector3d& normal, double size_u,
+                        double size_v, int divisions) {
   const Eigen::Vector3d n = normal.normalized();
   const Eigen::Vector3d helper =
       std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
@@ -126,8 +128,8 @@ TriangleMesh make_plane(const Eigen::Vector3d& center, const Eigen::Vector3d& no
   return m;
 }
 
-TriangleMesh make_cylinder(const Eigen::Vector3d& base, double radius, double height,
-                           int segments, bool bottom, bool top) {
+TriangleMesh make_cylinder(const Eigen::Vector3d& base, double radius, double height, int segments,
+                           bool bottom, bool top) {
   TriangleMesh m;
   const int s = std::max(3, segments);
   for (int k = 0; k < s; ++k) {

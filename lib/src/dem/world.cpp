@@ -1,9 +1,9 @@
 // World creation (validation once), accessors, energies and the state hash.
+#include <omp.h>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <omp.h>
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/dem/time_step.hpp"
@@ -25,8 +25,8 @@ TypeData make_type(const ClumpTypeSettings& t, const std::string& where, const s
   validate_spheres(t.clump.spheres, where + ": " + f + ".clump");
   const MassProperties& mp = t.clump.mass;
   if (!(mp.mass > 0.0) || !std::isfinite(mp.mass))
-    throw InputError(where, f + ".clump.mass", "the clump mass must be > 0 (got " +
-                                                   fmt_g(mp.mass) + " kg)");
+    throw InputError(where, f + ".clump.mass",
+                     "the clump mass must be > 0 (got " + fmt_g(mp.mass) + " kg)");
   Eigen::Matrix3d inertia = mp.inertia_tensor;
   if (inertia.isZero(0.0)) inertia = mp.principal_moments.asDiagonal();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (inertia + inertia.transpose()));
@@ -150,8 +150,8 @@ World World::create(WorldSettings s) {
   const auto names = s.materials.names();
   for (size_t a = 0; a < nm; ++a)
     for (size_t b = 0; b < nm; ++b) {
-      const bool used = (particle_mat[a] && (particle_mat[b] || wall_mat[b])) ||
-                        (particle_mat[b] && wall_mat[a]);
+      const bool used =
+          (particle_mat[a] && (particle_mat[b] || wall_mat[b])) || (particle_mat[b] && wall_mat[a]);
       const Material& ma = w.materials[a];
       const Material& mb = w.materials[b];
       const PairContactOverride* over = nullptr;
@@ -246,12 +246,10 @@ World World::create(WorldSettings s) {
     }
   (void)smallest_sphere;
   if (!(s.skin >= 0.0)) throw InputError(where, "skin", "must be >= 0 m");
-  if (!(s.rayleigh_fraction > 0.0))
-    throw InputError(where, "rayleigh_fraction", "must be > 0");
+  if (!(s.rayleigh_fraction > 0.0)) throw InputError(where, "rayleigh_fraction", "must be > 0");
   if (!(s.time_step >= 0.0) || !std::isfinite(s.time_step))
     throw InputError(where, "time_step", "must be > 0 s (or 0 for the default)");
-  if (!(s.max_impact_speed > 0.0))
-    throw InputError(where, "max_impact_speed", "must be > 0 m/s");
+  if (!(s.max_impact_speed > 0.0)) throw InputError(where, "max_impact_speed", "must be > 0 m/s");
   if (!(s.max_speed > 0.0)) throw InputError(where, "max_speed", "must be > 0 m/s");
   if (s.check_interval < 1) throw InputError(where, "check_interval", "must be >= 1");
   if (!s.gravity.allFinite()) throw InputError(where, "gravity", "must be finite");
@@ -359,8 +357,7 @@ double World::Impl::kinetic_energy() const {
   double e = 0.0;
   for (size_t c = 0; c < c_x.size(); ++c) {
     const TypeData& t = types[c_type[c]];
-    e += 0.5 * t.mass * c_v[c].squaredNorm() +
-         0.5 * c_wb[c].dot(t.inertia.cwiseProduct(c_wb[c]));
+    e += 0.5 * t.mass * c_v[c].squaredNorm() + 0.5 * c_wb[c].dot(t.inertia.cwiseProduct(c_wb[c]));
   }
   return e;
 }
@@ -392,62 +389,130 @@ std::uint64_t World::Impl::compute_fingerprint() const {
 }
 
 // Accessors.
-double World::time() const { return impl_->time; }
-long World::step_count() const { return impl_->steps; }
-double World::dt() const { return impl_->dt; }
-const std::vector<std::string>& World::warnings() const { return impl_->warnings; }
-const Profile& World::profile() const { return impl_->profile; }
-Profile& World::profile() { return impl_->profile; }
-const WorldSettings& World::settings() const { return impl_->settings; }
-int World::clump_type_count() const { return static_cast<int>(impl_->types.size()); }
+double World::time() const {
+  return impl_->time;
+}
+long World::step_count() const {
+  return impl_->steps;
+}
+double World::dt() const {
+  return impl_->dt;
+}
+const std::vector<std::string>& World::warnings() const {
+  return impl_->warnings;
+}
+const Profile& World::profile() const {
+  return impl_->profile;
+}
+Profile& World::profile() {
+  return impl_->profile;
+}
+const WorldSettings& World::settings() const {
+  return impl_->settings;
+}
+int World::clump_type_count() const {
+  return static_cast<int>(impl_->types.size());
+}
 int World::clump_type_index(const std::string& name) const {
   const auto& ct = impl_->settings.clump_types;
   for (size_t t = 0; t < ct.size(); ++t)
     if (ct[t].name == name) return static_cast<int>(t);
   throw InputError(impl_->settings.source, "clump_type", "unknown clump type '" + name + "'");
 }
-const ClumpTypeSettings& World::clump_type(int t) const { return impl_->settings.clump_types[t]; }
-double World::clump_type_mass(int t) const { return impl_->types[t].mass; }
-Eigen::Vector3d World::clump_type_inertia(int t) const { return impl_->types[t].inertia; }
-int World::clump_count() const { return static_cast<int>(impl_->c_x.size()); }
-long World::sphere_count() const { return static_cast<long>(impl_->s_r.size()); }
-int World::clump_type_of(int c) const { return impl_->c_type[c]; }
-double World::clump_mass(int c) const { return impl_->types[impl_->c_type[c]].mass; }
-const std::vector<Eigen::Vector3d>& World::positions() const { return impl_->c_x; }
-const std::vector<Eigen::Quaterniond>& World::orientations() const { return impl_->c_q; }
-const std::vector<Eigen::Vector3d>& World::velocities() const { return impl_->c_v; }
-const std::vector<Eigen::Vector3d>& World::omegas_body() const { return impl_->c_wb; }
-Eigen::Vector3d World::omega_world(int c) const { return impl_->c_R[c] * impl_->c_wb[c]; }
-void World::set_velocity(int c, const Eigen::Vector3d& v) { impl_->c_v[c] = v; }
+const ClumpTypeSettings& World::clump_type(int t) const {
+  return impl_->settings.clump_types[t];
+}
+double World::clump_type_mass(int t) const {
+  return impl_->types[t].mass;
+}
+Eigen::Vector3d World::clump_type_inertia(int t) const {
+  return impl_->types[t].inertia;
+}
+int World::clump_count() const {
+  return static_cast<int>(impl_->c_x.size());
+}
+long World::sphere_count() const {
+  return static_cast<long>(impl_->s_r.size());
+}
+int World::clump_type_of(int c) const {
+  return impl_->c_type[c];
+}
+double World::clump_mass(int c) const {
+  return impl_->types[impl_->c_type[c]].mass;
+}
+const std::vector<Eigen::Vector3d>& World::positions() const {
+  return impl_->c_x;
+}
+const std::vector<Eigen::Quaterniond>& World::orientations() const {
+  return impl_->c_q;
+}
+const std::vector<Eigen::Vector3d>& World::velocities() const {
+  return impl_->c_v;
+}
+const std::vector<Eigen::Vector3d>& World::omegas_body() const {
+  return impl_->c_wb;
+}
+Eigen::Vector3d World::omega_world(int c) const {
+  return impl_->c_R[c] * impl_->c_wb[c];
+}
+void World::set_velocity(int c, const Eigen::Vector3d& v) {
+  impl_->c_v[c] = v;
+}
 void World::set_omega_world(int c, const Eigen::Vector3d& w) {
   impl_->c_wb[c] = impl_->c_R[c].transpose() * w;
 }
-const std::vector<Eigen::Vector3d>& World::contact_forces() const { return impl_->c_f; }
-const std::vector<Eigen::Vector3d>& World::contact_torques() const { return impl_->c_t; }
-const std::vector<Eigen::Vector3d>& World::sphere_positions() const { return impl_->s_pos; }
-const std::vector<double>& World::sphere_radii() const { return impl_->s_r; }
-const std::vector<int>& World::sphere_clumps() const { return impl_->s_clump; }
-int World::wall_count() const { return static_cast<int>(impl_->walls.size()); }
+const std::vector<Eigen::Vector3d>& World::contact_forces() const {
+  return impl_->c_f;
+}
+const std::vector<Eigen::Vector3d>& World::contact_torques() const {
+  return impl_->c_t;
+}
+const std::vector<Eigen::Vector3d>& World::sphere_positions() const {
+  return impl_->s_pos;
+}
+const std::vector<double>& World::sphere_radii() const {
+  return impl_->s_r;
+}
+const std::vector<int>& World::sphere_clumps() const {
+  return impl_->s_clump;
+}
+int World::wall_count() const {
+  return static_cast<int>(impl_->walls.size());
+}
 int World::wall_index(const std::string& name) const {
   for (size_t k = 0; k < impl_->walls.size(); ++k)
     if (impl_->walls[k].name == name) return static_cast<int>(k);
   throw InputError(impl_->settings.source, "wall", "unknown wall '" + name + "'");
 }
-const WallSettings& World::wall_settings(int w) const { return impl_->settings.walls[w]; }
-const WallState& World::wall(int w) const { return impl_->walls[w].state; }
+const WallSettings& World::wall_settings(int w) const {
+  return impl_->settings.walls[w];
+}
+const WallState& World::wall(int w) const {
+  return impl_->walls[w].state;
+}
 const std::vector<Eigen::Vector3d>& World::wall_vertices(int w) const {
   return impl_->walls[w].vertices;
 }
-int World::factory_count() const { return static_cast<int>(impl_->factories.size()); }
-const FactoryStatus& World::factory_status(int f) const { return impl_->factories[f].status; }
+int World::factory_count() const {
+  return static_cast<int>(impl_->factories.size());
+}
+const FactoryStatus& World::factory_status(int f) const {
+  return impl_->factories[f].status;
+}
 bool World::factories_done() const {
   for (const auto& f : impl_->factories)
     if (!f.status.done) return false;
   return true;
 }
-double World::kinetic_energy() const { return impl_->kinetic_energy(); }
-double World::potential_energy() const { return impl_->potential_energy(); }
-double World::elastic_energy() const { return impl_->elastic; }
+double World::kinetic_energy() const {
+  return impl_->kinetic_energy();
+}
+double World::potential_energy() const {
+  return impl_->potential_energy();
+}
+double World::elastic_energy() const {
+  return impl_->elastic;
+}
 double World::total_mass() const {
   double m = 0.0;
   for (int t : impl_->c_type) m += impl_->types[t].mass;
@@ -464,8 +529,8 @@ std::vector<ContactInfo> World::contacts() const {
   std::vector<ContactInfo> out;
   for (const auto& pc : w.pair_contacts) {
     const PairEntry& p = w.pairs[pc.pair];
-    out.push_back({w.s_clump[p.i], w.s_clump[p.j], -1, pc.point, pc.normal, pc.overlap,
-                   pc.out.force});
+    out.push_back(
+        {w.s_clump[p.i], w.s_clump[p.j], -1, pc.point, pc.normal, pc.overlap, pc.out.force});
   }
   for (size_t s = 0; s < w.wall_contact_n.size(); ++s)
     for (int k = 0; k < w.wall_contact_n[s]; ++k) {
@@ -479,8 +544,8 @@ const ResolvedContact& World::resolved_contact(const std::string& a, const std::
   const auto& idx = impl_->material_index;
   auto ia = idx.find(a), ib = idx.find(b);
   if (ia == idx.end() || ib == idx.end())
-    throw InputError(impl_->settings.source, "material", "unknown material '" +
-                                                             (ia == idx.end() ? a : b) + "'");
+    throw InputError(impl_->settings.source, "material",
+                     "unknown material '" + (ia == idx.end() ? a : b) + "'");
   return impl_->law(ia->second, ib->second);
 }
 

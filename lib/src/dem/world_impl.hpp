@@ -21,8 +21,8 @@ struct TypeData {
   std::vector<double> radii;             // m
   double mass = 0.0;                     // kg
   Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // principal moments, kg m^2
-  double bound_radius = 0.0;  // max |offset| + radius, m
-  double volume = 0.0;        // union volume, m^3
+  double bound_radius = 0.0;                          // max |offset| + radius, m
+  double volume = 0.0;                                // union volume, m^3
   int material = 0;
 };
 
@@ -74,11 +74,11 @@ struct WallContactData {
 struct FactoryRuntime {
   FactorySettings s;
   std::vector<int> types;
-  std::vector<double> fractions;          // normalised mass fractions
-  std::vector<double> type_mass;          // kg inserted per mixture entry
+  std::vector<double> fractions;  // normalised mass fractions
+  std::vector<double> type_mass;  // kg inserted per mixture entry
   FactoryStatus status;
   std::mt19937_64 rng;
-  long batch = 0;        // next batch index
+  long batch = 0;         // next batch index
   double interval = 0.0;  // s
 };
 
@@ -89,8 +89,8 @@ struct World::Impl {
   double dt = 0.0;
   double time = 0.0;
   long steps = 0;
-  int threads = 1;       // threads used by the current step
-  int max_threads = 1;   // all cores, for threads = 0 (auto)
+  int threads = 1;      // threads used by the current step
+  int max_threads = 1;  // all cores, for threads = 0 (auto)
   std::vector<std::string> warnings;
   Profile profile;
 
@@ -105,7 +105,7 @@ struct World::Impl {
   std::vector<Eigen::Quaterniond> c_q;          // body → world
   std::vector<Eigen::Matrix3d> c_R;             // rotation matrix of c_q
   std::vector<Eigen::Vector3d> c_f, c_t;        // contact force / torque (no rolling), world
-  std::vector<double> c_mroll;  // standard rolling resistance: Σ μr R |Fn|, N m
+  std::vector<double> c_mroll;                  // standard rolling resistance: Σ μr R |Fn|, N m
   std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
 
   // Sub-spheres.
@@ -145,7 +145,7 @@ struct World::Impl {
   double check_energy = 0.0;  // KE + PE + elastic at the last check
   double check_ke = 0.0;
   double check_elastic = 0.0;
-  double wall_work = 0.0;       // J done by walls on particles since the last check
+  double wall_work = 0.0;        // J done by walls on particles since the last check
   double inserted_energy = 0.0;  // J brought in by factories since the last check
   bool check_initialised = false;
 

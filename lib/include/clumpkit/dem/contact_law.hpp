@@ -73,12 +73,12 @@ ResolvedContact resolve(const Material& a, const Material& b, const PairContact&
 
 /// Geometry and kinematics of one contact, body i against body j (j may be a wall).
 struct ContactKinematics {
-  Eigen::Vector3d normal;  ///< unit, from j towards i
-  double overlap = 0.0;    ///< δ > 0, m
-  double r_star = 0.0;     ///< m
-  double m_star = 0.0;     ///< kg
-  double radius_i = 0.0;   ///< sub-sphere radius of i (standard rolling), m
-  double radius_j = 0.0;   ///< of j, 0 for a wall
+  Eigen::Vector3d normal;   ///< unit, from j towards i
+  double overlap = 0.0;     ///< δ > 0, m
+  double r_star = 0.0;      ///< m
+  double m_star = 0.0;      ///< kg
+  double radius_i = 0.0;    ///< sub-sphere radius of i (standard rolling), m
+  double radius_j = 0.0;    ///< of j, 0 for a wall
   Eigen::Vector3d v_rel;    ///< velocity of i minus velocity of j at the contact point, m/s
   Eigen::Vector3d omega_i;  ///< world angular velocity of clump i, rad/s
   Eigen::Vector3d omega_j;  ///< of clump j or of the wall
@@ -91,7 +91,7 @@ struct ContactHistory {
 };
 
 struct ContactForce {
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on i (j gets −force), N
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< on i (j gets −force), N
   /// Rolling torque on clump i / j (CDT and EPSD models), N m.
   Eigen::Vector3d torque_i = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();
@@ -100,8 +100,8 @@ struct ContactForce {
   /// clump at rest stays at rest), limited so that it stops a rotation but never reverses it.
   double roll_i = 0.0;
   double roll_j = 0.0;
-  double normal = 0.0;            ///< signed normal force (Hertz + damping + cohesion), N
-  double elastic_energy = 0.0;    ///< stored in the normal and tangential springs, J
+  double normal = 0.0;          ///< signed normal force (Hertz + damping + cohesion), N
+  double elastic_energy = 0.0;  ///< stored in the normal and tangential springs, J
 };
 
 /// Evaluates the law for one contact over a step of `dt`, updating the history springs.

@@ -17,8 +17,8 @@ struct BoxRegion {
 /// Axis +z through `base_center`.
 struct CylinderRegion {
   Eigen::Vector3d base_center = Eigen::Vector3d::Zero();  ///< m
-  double radius = 0.0;                                     ///< m
-  double height = 0.0;                                     ///< m
+  double radius = 0.0;                                    ///< m
+  double height = 0.0;                                    ///< m
 };
 
 using Region = std::variant<BoxRegion, CylinderRegion>;
@@ -35,13 +35,13 @@ struct FactorySettings {
   std::string name = "factory";
   Region region = BoxRegion{};
   std::vector<MixtureEntry> mixture;
-  std::optional<long> count;    ///< clumps to insert; exactly one of count and mass
-  std::optional<double> mass;   ///< kg to insert (stops at the clump that comes closest)
+  std::optional<long> count;   ///< clumps to insert; exactly one of count and mass
+  std::optional<double> mass;  ///< kg to insert (stops at the clump that comes closest)
   /// 0 = everything at start_time (an InputError when the region cannot hold it); otherwise
   /// clumps/s (with count) or kg/s (with mass), inserted in batches every `interval`.
   double rate = 0.0;
-  double start_time = 0.0;      ///< s
-  double interval = 0.0;        ///< s between batches; 0 = the free-fall time of the region
+  double start_time = 0.0;  ///< s
+  double interval = 0.0;    ///< s between batches; 0 = the free-fall time of the region
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< initial velocity, m/s
   bool random_orientation = true;
   int attempts_per_clump = 200;  ///< random placements tried before giving up on a clump
@@ -52,7 +52,7 @@ struct FactoryStatus {
   long inserted = 0;
   double inserted_mass = 0.0;  ///< kg
   bool done = false;
-  long failed_attempts = 0;    ///< placements rejected for overlap
+  long failed_attempts = 0;  ///< placements rejected for overlap
 };
 
 }  // namespace clumpkit::dem

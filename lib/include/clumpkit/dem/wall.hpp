@@ -24,7 +24,7 @@ struct TriangleMesh {
 /// Piecewise-linear velocity keyframes (t_k, v_k); the first and last velocities are held
 /// outside the keyed range. No keys = at rest.
 struct VelocityProfile {
-  std::vector<double> times;                  ///< s, strictly increasing
+  std::vector<double> times;                ///< s, strictly increasing
   std::vector<Eigen::Vector3d> velocities;  ///< m/s
 
   static VelocityProfile constant(const Eigen::Vector3d& v) { return {{0.0}, {v}}; }
@@ -37,10 +37,10 @@ struct VelocityProfile {
 /// Rotation at a constant rate about an axis through `axis_point` (which moves with the wall's
 /// translation), between start_time and stop_time.
 struct WallRotation {
-  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();  ///< m, at t = 0
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();       ///< direction (normalised on use)
-  double rpm = 0.0;                                      ///< revolutions per minute, signed
-  double start_time = 0.0;                               ///< s
+  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();        ///< m, at t = 0
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();             ///< direction (normalised on use)
+  double rpm = 0.0;                                            ///< revolutions per minute, signed
+  double start_time = 0.0;                                     ///< s
   double stop_time = std::numeric_limits<double>::infinity();  ///< s
 
   double angular_speed() const;  ///< rad/s
@@ -54,8 +54,8 @@ struct WallMotion {
 
 struct WallSettings {
   std::string name;
-  TriangleMesh mesh;             ///< at t = 0, metres
-  std::string material;          ///< a MaterialLibrary name
+  TriangleMesh mesh;     ///< at t = 0, metres
+  std::string material;  ///< a MaterialLibrary name
   WallMotion motion;
   /// The wall torque is reported about this point (moving with the wall's translation), m.
   /// Defaults to the rotation axis point when the wall rotates.
@@ -65,7 +65,7 @@ struct WallSettings {
 /// Wall kinematics at time t: x(t) = R(t) (X − p0) + p0 + D(t).
 struct WallPose {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();  ///< p0 + D(t)
+  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();       ///< p0 + D(t)
   Eigen::Vector3d reference_point = Eigen::Vector3d::Zero();  ///< p0 at t = 0
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();         ///< translation, m/s
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();            ///< rad/s
@@ -84,8 +84,8 @@ WallPose wall_pose(const WallMotion& motion, double t);
 
 /// A flat rectangle centred at `center`, normal `normal`, side lengths `size`, split into
 /// `divisions` × `divisions` squares of two triangles each.
-TriangleMesh make_plane(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
-                        double size_u, double size_v, int divisions = 1);
+TriangleMesh make_plane(const Eigen::Vector3d& center, const Eigen::Vector3d& normal, double size_u,
+                        double size_v, int divisions = 1);
 /// Lateral surface of a cylinder about the z axis through `base_center`, plus a bottom disc when
 /// `bottom` is true, plus a top disc when `top` is true.
 TriangleMesh make_cylinder(const Eigen::Vector3d& base_center, double radius, double height,

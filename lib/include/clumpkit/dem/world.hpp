@@ -57,8 +57,8 @@ struct WorldSettings {
   /// least 10 steps (InputError below 4, warning below 10). At 0.2 T_R a 2 m/s pill-pill
   /// impact spans about 14 steps.
   double max_impact_speed = 2.0;
-  double skin = 0.0;  ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
-  int threads = 0;    ///< OpenMP threads; 0 = all
+  double skin = 0.0;       ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
+  int threads = 0;         ///< OpenMP threads; 0 = all
   std::uint64_t seed = 1;  ///< factories' random stream
 
   /// Blow-up detection: checked every `check_interval` steps.
@@ -77,8 +77,8 @@ struct WallState {
 /// A sub-sphere contact, for diagnostics (coordination number, force chains).
 struct ContactInfo {
   int clump_i = -1;
-  int clump_j = -1;  ///< −1 for a wall contact
-  int wall = -1;     ///< wall index for a wall contact
+  int clump_j = -1;        ///< −1 for a wall contact
+  int wall = -1;           ///< wall index for a wall contact
   Eigen::Vector3d point;   ///< m
   Eigen::Vector3d normal;  ///< unit, from j (or the wall) to i
   double overlap = 0.0;    ///< m
@@ -129,7 +129,7 @@ class World {
   long sphere_count() const;
   int clump_type_of(int c) const;
   double clump_mass(int c) const;
-  const std::vector<Eigen::Vector3d>& positions() const;      ///< centres of mass, m
+  const std::vector<Eigen::Vector3d>& positions() const;        ///< centres of mass, m
   const std::vector<Eigen::Quaterniond>& orientations() const;  ///< body → world
   const std::vector<Eigen::Vector3d>& velocities() const;       ///< m/s
   const std::vector<Eigen::Vector3d>& omegas_body() const;      ///< rad/s, principal frame
@@ -161,10 +161,10 @@ class World {
   /// Active sub-sphere contacts after the last force evaluation, in a fixed order.
   std::vector<ContactInfo> contacts() const;
   int contact_count() const;
-  double kinetic_energy() const;     ///< J, translational + rotational
-  double potential_energy() const;   ///< J, −Σ m g·x
-  double elastic_energy() const;     ///< J, stored in the contact springs (last evaluation)
-  double total_mass() const;         ///< kg
+  double kinetic_energy() const;    ///< J, translational + rotational
+  double potential_energy() const;  ///< J, −Σ m g·x
+  double elastic_energy() const;    ///< J, stored in the contact springs (last evaluation)
+  double total_mass() const;        ///< kg
 
   /// FNV-1a over the full dynamic state (time, positions, orientations, velocities, contact
   /// histories, wall poses, factory progress). Equal hashes = bit-identical states.
