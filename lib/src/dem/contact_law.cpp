@@ -107,12 +107,10 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   const double sn = 2.0 * law.e_star * sqrt_rd;
   const double f_hertz = (4.0 / 3.0) * law.e_star * sqrt_rd * delta;
   const double vn = k.v_rel.dot(n);
+  const Eigen::Vector3d& vd = k.v_rel_damping ? *k.v_rel_damping : k.v_rel;
+  const double vdn = vd.dot(n);
   double fn = f_hertz;
-  double cn = 0.0;
-  if (law.damping) {
-    cn = kDampingFactor * law.beta * std::sqrt(sn * k.m_star);
-    fn -= cn * vn;
-  }
+  if (law.damping) fn -= kDampingFactor * law.beta * std::sqrt(sn * k.m_star) * vdn;
   const double fn_contact = fn;  // Coulomb and rolling limits use the contact force
   if (law.cohesion) fn -= law.cohesion_k * 2.0 * 3.14159265358979323846 * k.r_star * delta;
   out.force = fn * n;
@@ -128,7 +126,7 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
     const Eigen::Vector3d vt = k.v_rel - vn * n;
     h.shear = project_to_tangent(h.shear, n) + vt * dt;
     Eigen::Vector3d ft = -st * h.shear;
-    if (law.damping) ft -= kDampingFactor * law.beta * std::sqrt(st * k.m_star) * vt;
+    if (law.damping) ft -= kDampingFactor * law.beta * std::sqrt(st * k.m_star) * (vd - vdn * n);
     const double cap = law.mu_s * std::abs(fn_contact);
     const double ft_norm = ft.norm();
     if (ft_norm > cap) {

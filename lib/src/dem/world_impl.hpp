@@ -107,6 +107,7 @@ struct World::Impl {
   std::vector<Eigen::Vector3d> c_f, c_t;        // contact force / torque (no rolling), world
   std::vector<double> c_mroll;                  // standard rolling resistance: Σ μr R |Fn|, N m
   std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
+  std::vector<Eigen::Vector3d> c_vp;            // predicted v(t) for damping (scratch)
 
   // Sub-spheres.
   std::vector<int> s_clump;

@@ -73,13 +73,17 @@ ResolvedContact resolve(const Material& a, const Material& b, const PairContact&
 
 /// Geometry and kinematics of one contact, body i against body j (j may be a wall).
 struct ContactKinematics {
-  Eigen::Vector3d normal;   ///< unit, from j towards i
-  double overlap = 0.0;     ///< δ > 0, m
-  double r_star = 0.0;      ///< m
-  double m_star = 0.0;      ///< kg
-  double radius_i = 0.0;    ///< sub-sphere radius of i (standard rolling), m
-  double radius_j = 0.0;    ///< of j, 0 for a wall
-  Eigen::Vector3d v_rel;    ///< velocity of i minus velocity of j at the contact point, m/s
+  Eigen::Vector3d normal;  ///< unit, from j towards i
+  double overlap = 0.0;    ///< δ > 0, m
+  double r_star = 0.0;     ///< m
+  double m_star = 0.0;     ///< kg
+  double radius_i = 0.0;   ///< sub-sphere radius of i (standard rolling), m
+  double radius_j = 0.0;   ///< of j, 0 for a wall
+  Eigen::Vector3d v_rel;   ///< velocity of i minus velocity of j at the contact point, m/s
+  /// The same relative velocity at the time of the positions, for the damping terms only (the
+  /// World passes velocity Verlet's predicted v(t); v_rel is the half-step velocity, which moves
+  /// the springs consistently with the positions). Absent = v_rel.
+  std::optional<Eigen::Vector3d> v_rel_damping;
   Eigen::Vector3d omega_i;  ///< world angular velocity of clump i, rad/s
   Eigen::Vector3d omega_j;  ///< of clump j or of the wall
 };
