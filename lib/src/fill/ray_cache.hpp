@@ -1,0 +1,54 @@
+#pragma once
+// A fixed set of jittered axis-parallel lines through a box (three axes), with the target
+// shape's intervals cached on each. Evaluating a sphere set then only intersects spheres: the
+// common random numbers make the sampled symmetric difference a deterministic, piecewise-smooth
+// function of the sphere parameters, cheap enough to call inside an optimiser.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+#include "clumpkit/geometry/ray_moments.hpp"
+#include "clumpkit/geometry/ray_solid.hpp"
+#include "clumpkit/geometry/sphere.hpp"
+
+namespace clumpkit::detail {
+
+class RayCache {
+ public:
+  RayCache(const RaySolid& shape, const Eigen::AlignedBox3d& box, std::int64_t rays,
+           std::uint64_t seed, int threads);
+
+  struct Eval {
+    double xor_volume = 0.0;    ///< m^3, mean of the three axes
+    double union_volume = 0.0;  ///< m^3
+    Moments union_moments;      ///< only when requested
+  };
+  /// Spheres outside the box are clipped to it (they are infeasible for the fill anyway). With
+  /// `removal_cost`, also the increase of the XOR volume (m^3) if each sphere alone were removed:
+  /// its exclusively covered length inside the shape minus that outside.
+  Eval evaluate(const Spheres& spheres, bool moments = false,
+                std::vector<double>* removal_cost = nullptr) const;
+
+  double shape_volume() const { return shape_volume_; }
+  const Moments& shape_moments() const { return shape_moments_; }
+
+ private:
+  struct Axis {
+    int nu = 0, nv = 0;
+    double u0 = 0, v0 = 0, du = 0, dv = 0;
+    std::vector<double> pu, pv;        // per line (i * nv + j)
+    std::vector<int> first;            // per line: first shape interval, size lines + 1
+    std::vector<Interval> shape;       // flattened shape intervals
+    std::vector<double> shape_length;  // per line
+    double shape_total = 0.0;          // sum of lengths
+  };
+  Axis axes_[3];
+  double shape_volume_ = 0.0;
+  Moments shape_moments_;
+};
+
+/// Moments of a normalised interval list along one line (as integrate_rays accumulates them).
+void accumulate_moments(const IntervalList& list, int axis, double pu, double pv, double area,
+                        Moments& m);
+
+}  // namespace clumpkit::detail
