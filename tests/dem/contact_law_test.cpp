@@ -174,3 +174,33 @@ INSTANTIATE_TEST_SUITE_P(DEM, Restitution, ::testing::Values(0.2, 0.3, 0.5, 0.7,
 
 }  // namespace
 }  // namespace clumpkit::dem
+
+namespace clumpkit::dem {
+namespace {
+
+// Cohesion as a World effect: two spheres pressed together stay together with SJKR and part
+// without it (all else equal and elastic).
+TEST(ContactLaw, CohesionHoldsSpheresTogether) {
+  auto final_gap = [](bool cohesive) {
+    WorldSettings s;
+    s.gravity.setZero();
+    PairContact law;
+    law.restitution = 0.3;
+    if (cohesive) law.cohesion = Cohesion{2e6};
+    s.pair_contacts.push_back({"pill", "pill", law});
+    const double r = 1e-3;
+    s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+    World w = World::create(s);
+    w.add_clump(0, Eigen::Vector3d(-r, 0, 0), Eigen::Quaterniond::Identity(),
+                Eigen::Vector3d(0.02, 0, 0));
+    w.add_clump(0, Eigen::Vector3d(r, 0, 0), Eigen::Quaterniond::Identity(),
+                Eigen::Vector3d(-0.02, 0, 0));
+    w.run_until(0.005);
+    return (w.positions()[1] - w.positions()[0]).norm() - 2.0 * r;
+  };
+  EXPECT_LT(final_gap(true), 0.0);
+  EXPECT_GT(final_gap(false), 1e-5);
+}
+
+}  // namespace
+}  // namespace clumpkit::dem

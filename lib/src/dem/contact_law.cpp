@@ -112,10 +112,14 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   double fn = f_hertz;
   if (law.damping) fn -= kDampingFactor * law.beta * std::sqrt(sn * k.m_star) * vdn;
   const double fn_contact = fn;  // Coulomb and rolling limits use the contact force
-  if (law.cohesion) fn -= law.cohesion_k * 2.0 * 3.14159265358979323846 * k.r_star * delta;
+  out.elastic_energy = 0.4 * f_hertz * delta;
+  if (law.cohesion) {
+    fn -= law.cohesion_k * 2.0 * std::numbers::pi * k.r_star * delta;
+    // Its potential, −k π R* δ², so the energy balance of the blow-up check stays closed.
+    out.elastic_energy -= law.cohesion_k * std::numbers::pi * k.r_star * delta * delta;
+  }
   out.force = fn * n;
   out.normal = fn;
-  out.elastic_energy = 0.4 * f_hertz * delta;
   out.torque_i.setZero();
   out.torque_j.setZero();
   out.roll_i = out.roll_j = 0.0;

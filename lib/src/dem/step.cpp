@@ -457,7 +457,7 @@ void World::Impl::check_health() {
   double floor = 1e-12;
   for (int c = 0; c < nc; ++c) floor += types[c_type[c]].mass * settings.gravity.norm() * r_min;
   const double scale =
-      check_ke + check_elastic + std::abs(wall_work) + std::abs(inserted_energy) + floor;
+      check_ke + std::abs(check_elastic) + std::abs(wall_work) + std::abs(inserted_energy) + floor;
   if (excess > scale)
     fail("energy jumped by " + fmt_g(excess) + " J in " + std::to_string(settings.check_interval) +
          " steps with no source (kinetic " + fmt_g(check_ke) + " -> " + fmt_g(ke) +

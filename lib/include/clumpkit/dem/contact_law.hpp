@@ -105,7 +105,7 @@ struct ContactForce {
   double roll_i = 0.0;
   double roll_j = 0.0;
   double normal = 0.0;          ///< signed normal force (Hertz + damping + cohesion), N
-  double elastic_energy = 0.0;  ///< stored in the normal and tangential springs, J
+  double elastic_energy = 0.0;  ///< stored in the springs, minus the cohesive well, J
 };
 
 /// Evaluates the law for one contact over a step of `dt`, updating the history springs.
