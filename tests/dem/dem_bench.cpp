@@ -1,7 +1,7 @@
 // Benchmark (not a test): a pour of 12-sphere pills (paper models A, B, C, mass fractions
 // 35/35/30 %) from a cylinder factory into an organic-glass cup, with the per-stage profile.
 //
-//   dem_bench [pills=300] [threads=2] [sim_time_s=0.25]
+//   dem_bench [pills=300] [threads=2] [sim_time_s=0.25] [skin_m=default]
 //
 // Prints sphere-steps/s and clump-steps/s over the whole run (wall clock of World::step).
 #include <chrono>
@@ -17,10 +17,12 @@ int main(int argc, char** argv) {
   const long pills = argc > 1 ? std::atol(argv[1]) : 300;
   const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
   const double until = argc > 3 ? std::atof(argv[3]) : 0.25;
+  const double skin = argc > 4 ? std::atof(argv[4]) : 0.0;  // m, 0 = the default
 
   dem::WorldSettings s;
   s.source = "dem_bench";
   s.threads = threads;
+  s.skin = skin;
   const struct {
     const char* name;
     double height, fraction;
