@@ -1,0 +1,84 @@
+#pragma once
+/// Where simulated observables come from. The calibration loop asks a Simulator for the
+/// observables of one (model, rig, sample, setting) at a number of repeats; RigSimulator runs
+/// the real rigs and caches every result on disk, keyed by the model's content, rig, sample,
+/// setting, scale, seed and repeats, so nothing is simulated twice.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "clumpkit/calibrate/comparison.hpp"
+#include "clumpkit/calibrate/measurements.hpp"
+#include "clumpkit/rigs/model.hpp"
+
+namespace clumpkit::calibrate {
+
+/// One rig run to make: rig, sample (pill type name or "mix") and normalised settings
+/// (including `scale`).
+struct SimRequest {
+  std::string rig;
+  std::string sample;
+  std::map<std::string, std::string> settings;
+  std::string key() const;  ///< rig|sample|settings
+};
+
+/// Quantity name -> simulated value in the quantity's canonical unit (deg, kg/m^3, kg, 1, kg/s).
+using SimValues = std::map<std::string, SimulatedValue>;
+
+class Simulator {
+ public:
+  virtual ~Simulator() = default;
+  virtual SimValues simulate(const ParticleModel& model, const SimRequest& request, int repeats,
+                             std::uint64_t seed) = 0;
+  /// Number of simulate() calls that really ran (not served from a cache).
+  long runs() const { return runs_; }
+
+ protected:
+  long runs_ = 0;
+};
+
+/// The model restricted to one sample: a pill type ("A") alone, or the whole mixture ("mix").
+/// Throws InputError naming `where` when the model has no such type.
+ParticleModel model_for_sample(const ParticleModel& model, const std::string& sample,
+                               const std::string& where);
+
+/// The distinct rig runs a set of measurements needs. `scale` is added to each setting that does
+/// not give one.
+std::vector<SimRequest> requests_for(const std::vector<Measurement>& measurements,
+                                     const std::string& scale);
+
+/// Simulates what the measurements need and returns values keyed by Measurement::key().
+std::map<std::string, SimulatedValue> simulate_measurements(
+    Simulator& sim, const ParticleModel& model, const std::vector<Measurement>& measurements,
+    const std::string& scale, int repeats, std::uint64_t seed);
+
+/// A stable text of everything in a model that changes the physics (for cache keys).
+std::string model_fingerprint(const ParticleModel& model);
+
+/// The real rigs, with an on-disk cache (one JSON per run, written atomically).
+class RigSimulator final : public Simulator {
+ public:
+  struct Options {
+    std::filesystem::path cache_dir = "clumpkit_cache";
+    int threads = 0;
+    long rays = 20000;
+    std::function<void(const std::string&)> progress;
+  };
+  explicit RigSimulator(Options options);
+  SimValues simulate(const ParticleModel& model, const SimRequest& request, int repeats,
+                     std::uint64_t seed) override;
+  long cache_hits() const { return hits_; }
+
+ private:
+  Options opt_;
+  long hits_ = 0;
+};
+
+/// Converts a rig result's SI statistics to canonical-unit simulated values per quantity.
+SimValues to_canonical(const std::string& rig, const std::map<std::string, double>& mean_si,
+                       const std::map<std::string, double>& std_si, int n);
+
+}  // namespace clumpkit::calibrate

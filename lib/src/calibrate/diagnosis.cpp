@@ -1,0 +1,356 @@
+#include "clumpkit/calibrate/diagnosis.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "clumpkit/rigs/catalogue.hpp"
+
+namespace clumpkit::calibrate {
+
+namespace {
+
+// Regularised upper incomplete gamma Q(a, x) (series for x < a + 1, continued fraction beyond).
+double gamma_q(double a, double x) {
+  if (x <= 0) return 1.0;
+  const double gln = std::lgamma(a);
+  if (x < a + 1.0) {
+    double sum = 1.0 / a, del = sum, ap = a;
+    for (int n = 0; n < 1000; ++n) {
+      ap += 1.0;
+      del *= x / ap;
+      sum += del;
+      if (std::abs(del) < std::abs(sum) * 1e-15) break;
+    }
+    return 1.0 - sum * std::exp(-x + a * std::log(x) - gln);
+  }
+  const double tiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < 1000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < tiny) d = tiny;
+    c = b + an / c;
+    if (std::abs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    const double del = d * c;
+    h *= del;
+    if (std::abs(del - 1.0) < 1e-15) break;
+  }
+  return std::exp(-x + a * std::log(x) - gln) * h;
+}
+
+using Values = std::map<std::string, SimulatedValue>;
+
+// Piecewise-linear response surrogate of one candidate: simulated points (theta, values).
+struct Surrogate {
+  std::vector<std::pair<double, Values>> points;  // sorted by theta
+
+  void add(double theta, Values v) {
+    for (auto& p : points)
+      if (p.first == theta) {
+        p.second = std::move(v);
+        return;
+      }
+    points.emplace_back(theta, std::move(v));
+    std::sort(points.begin(), points.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+  }
+  double value(const std::string& key, double theta) const {
+    if (points.size() == 1) return points[0].second.at(key).mean;
+    size_t k = 1;
+    while (k + 1 < points.size() && points[k].first < theta) ++k;
+    const auto& [t0, v0] = points[k - 1];
+    const auto& [t1, v1] = points[k];
+    const double y0 = v0.at(key).mean, y1 = v1.at(key).mean;
+    return y0 + (y1 - y0) * (theta - t0) / (t1 - t0);
+  }
+};
+
+double chi2_of(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
+               double theta) {
+  double chi2 = 0;
+  for (const auto& m : ms) {
+    const SimulatedValue& b = base.at(m.key());
+    const double var = m.std * m.std / m.n + (b.n > 0 ? b.std * b.std / b.n : 0.0);
+    const double d = s.value(m.key(), theta) - m.value;
+    chi2 += d * d / var;
+  }
+  return chi2;
+}
+
+struct Fit {
+  double theta = 0, chi2 = 0, sigma = 0;
+};
+
+Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
+                  double lo, double hi) {
+  const int n = 2000;
+  std::vector<double> th(n + 1), c(n + 1);
+  Fit f;
+  f.chi2 = std::numeric_limits<double>::infinity();
+  int best = 0;
+  for (int i = 0; i <= n; ++i) {
+    th[i] = lo + (hi - lo) * i / n;
+    c[i] = chi2_of(ms, base, s, th[i]);
+    if (c[i] < f.chi2) {
+      f.chi2 = c[i];
+      best = i;
+    }
+  }
+  f.theta = th[best];
+  // Delta chi2 = 1 interval on the surrogate; an open side extends to the range bound.
+  int a = best, b = best;
+  while (a > 0 && c[a] < f.chi2 + 1.0) --a;
+  while (b < n && c[b] < f.chi2 + 1.0) ++b;
+  f.sigma = 0.5 * (th[b] - th[a]);
+  return f;
+}
+
+std::string observable_name(const Measurement& m) {
+  const std::string s = m.setting_text();
+  return fmt::format("{} {}{} {}", m.rig, m.sample, s.empty() ? "" : " [" + s + "]", m.quantity);
+}
+
+}  // namespace
+
+double chi2_survival(double x, int dof) { return gamma_q(0.5 * dof, 0.5 * x); }
+
+Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms, Simulator& sim,
+                   const DiagnoseOptions& o) {
+  Diagnosis d;
+  const long runs0 = sim.runs();
+  auto say = [&](const std::string& s) {
+    if (o.progress) o.progress(s);
+  };
+  auto simulate = [&](const ParticleModel& m) {
+    return simulate_measurements(sim, m, ms, o.scale, o.repeats, o.seed);
+  };
+  const int n = static_cast<int>(ms.size());
+  const double ln_n = std::log(std::max(1, n));
+
+  say("baseline model " + base.name);
+  const Values s0 = simulate(base);
+  d.baseline = compare(ms, s0, 0);
+  d.baseline_bic = d.baseline.bic;
+  d.baseline_p = chi2_survival(d.baseline.chi2, n);
+
+  const std::vector<EffectCandidate> cands = effect_candidates(base, o.effects, &d.skipped);
+  struct Work {
+    EffectCandidate c;
+    Surrogate s;
+    Fit fit;
+    Values at_fit;
+    bool have_at_fit = false;
+  };
+  std::vector<Work> work;
+  for (const auto& c : cands) {
+    Work w{c, {}, {}, {}, false};
+    if (c.discrete) {
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t i = 0; i < c.levels.size(); ++i) {
+        say(fmt::format("{}: {}", c.effect, c.level_names[i]));
+        Values v = simulate(c.apply(base, c.levels[i]));
+        const double chi2 = compare(ms, v, 1).chi2;
+        if (chi2 < best) {
+          best = chi2;
+          w.fit = {c.levels[i], chi2, 0.0};
+          w.at_fit = v;
+          w.have_at_fit = true;
+        }
+      }
+    } else {
+      say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
+      w.s.add(c.baseline, s0);
+      w.s.add(c.probe, simulate(c.apply(base, c.probe)));
+      w.fit = fit_surrogate(ms, s0, w.s, c.lo, c.hi);
+    }
+    work.push_back(std::move(w));
+  }
+  // Refine the leading continuous candidates with real runs at their fitted values.
+  std::vector<size_t> order(work.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return work[a].fit.chi2 < work[b].fit.chi2; });
+  for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r) {
+    Work& w = work[order[r]];
+    if (w.c.discrete) continue;
+    for (int step = 0; step < o.refinements; ++step) {
+      say(fmt::format("{}: refining at {}", w.c.effect, w.c.format(w.fit.theta)));
+      Values v = simulate(w.c.apply(base, w.fit.theta));
+      w.s.add(w.fit.theta, v);
+      const Fit next = fit_surrogate(ms, s0, w.s, w.c.lo, w.c.hi);
+      const bool converged = std::abs(next.theta - w.fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
+      w.fit = next;
+      if (converged) break;
+    }
+  }
+  // Every candidate's reported chi2 comes from a real simulation at its fitted value.
+  for (Work& w : work) {
+    if (!w.have_at_fit) {
+      bool found = false;
+      for (const auto& [t, v] : w.s.points)
+        if (t == w.fit.theta) {
+          w.at_fit = v;
+          found = true;
+        }
+      if (!found) {
+        say(fmt::format("{}: confirming at {}", w.c.effect, w.c.format(w.fit.theta)));
+        w.at_fit = simulate(w.c.apply(base, w.fit.theta));
+        w.s.add(w.fit.theta, w.at_fit);
+      }
+    }
+    CandidateResult r;
+    r.candidate = w.c;
+    r.fitted = w.fit.theta;
+    r.fitted_std = w.fit.sigma;
+    r.comparison = compare(ms, w.at_fit, 1);
+    r.delta_chi2 = d.baseline.chi2 - r.comparison.chi2;
+    r.bic = r.comparison.chi2 + ln_n;
+    const double span = w.c.hi - w.c.lo;
+    r.at_bound = !w.c.discrete && (r.fitted <= w.c.lo + 0.01 * span || r.fitted >= w.c.hi - 0.01 * span);
+    r.plausible = w.c.discrete || (r.fitted >= w.c.lo && r.fitted <= w.c.hi && !r.at_bound);
+    d.candidates.push_back(r);
+  }
+  std::sort(d.candidates.begin(), d.candidates.end(),
+            [](const CandidateResult& a, const CandidateResult& b) { return a.bic < b.bic; });
+  // Posterior weights over baseline + candidates.
+  double best_bic = d.baseline_bic;
+  for (const auto& c : d.candidates) best_bic = std::min(best_bic, c.bic);
+  double z = std::exp(-0.5 * (d.baseline_bic - best_bic));
+  for (const auto& c : d.candidates) z += std::exp(-0.5 * (c.bic - best_bic));
+  for (auto& c : d.candidates) c.weight = std::exp(-0.5 * (c.bic - best_bic)) / z;
+  const double baseline_weight = std::exp(-0.5 * (d.baseline_bic - best_bic)) / z;
+
+  d.consistent = true;
+  d.confidence = baseline_weight;
+  if (!d.candidates.empty()) {
+    const CandidateResult& top = d.candidates.front();
+    if (d.baseline_p < o.p_inconsistent && d.baseline_bic - top.bic >= o.min_delta_bic) {
+      d.consistent = false;
+      d.verdict = top.candidate.effect;
+      d.confidence = top.weight;
+      for (size_t i = 1; i < d.candidates.size(); ++i)
+        if (d.candidates[i].bic - top.bic < 2.0)
+          d.indistinguishable.push_back(d.candidates[i].candidate.effect);
+      // Observables whose misfit the winner removes most.
+      std::vector<std::pair<double, std::string>> gain;
+      for (size_t i = 0; i < ms.size(); ++i) {
+        const double z0 = d.baseline.observables[i].z, z1 = top.comparison.observables[i].z;
+        gain.emplace_back(z0 * z0 - z1 * z1,
+                          fmt::format("{}: z {:+.2f} -> {:+.2f}", observable_name(ms[i]), z0, z1));
+      }
+      std::sort(gain.rbegin(), gain.rend());
+      for (size_t i = 0; i < gain.size() && i < 3; ++i)
+        if (gain[i].first > 0) d.drivers.push_back(gain[i].second);
+    }
+  }
+
+  // Which unmeasured rig setting would best separate the two leading explanations?
+  if (o.suggest && d.candidates.size() >= 2 && o.suggest_max > 0) {
+    const CandidateResult& a = d.candidates[0];
+    const CandidateResult& b = d.candidates[1];
+    const ParticleModel ma = a.candidate.apply(base, a.fitted);
+    const ParticleModel mb = b.candidate.apply(base, b.fitted);
+    std::set<std::string> measured;
+    std::map<std::string, double> rel_std;  // typical relative noise per quantity
+    std::map<std::string, std::string> sample_of_rig;
+    for (const auto& m : ms) {
+      SimRequest r{m.rig, m.sample, m.setting};
+      if (!r.settings.count("scale")) r.settings["scale"] = o.scale;
+      measured.insert(r.key());
+      if (m.value != 0) rel_std[m.quantity] = std::max(rel_std[m.quantity], m.std / std::abs(m.value));
+      sample_of_rig.emplace(m.rig, m.sample);
+    }
+    std::vector<SimRequest> trial;
+    for (const auto& rig : rig_catalogue()) {
+      const std::string sample = sample_of_rig.count(rig.name) ? sample_of_rig[rig.name] : ms.front().sample;
+      for (const auto& st : rig.settings) {
+        std::vector<std::string> values = st.choices;
+        if (st.key == "rpm") values = {"10", "15", "30"};
+        if (st.key == "scale" || values.empty()) continue;
+        for (const auto& v : values) {
+          SimRequest r{rig.name, sample, parse_settings(rig, st.key + "=" + v, "suggest")};
+          r.settings["scale"] = o.scale;
+          if (!measured.count(r.key())) trial.push_back(r);
+        }
+      }
+    }
+    // Prefer rigs that were measured (their setup is known to work), then catalogue order.
+    std::stable_sort(trial.begin(), trial.end(), [&](const SimRequest& x, const SimRequest& y) {
+      return sample_of_rig.count(x.rig) > sample_of_rig.count(y.rig);
+    });
+    if (static_cast<int>(trial.size()) > o.suggest_max) trial.resize(o.suggest_max);
+    for (const auto& r : trial) {
+      say(fmt::format("suggestion: trying {} [{}]", r.rig, format_settings(r.settings)));
+      SimValues va, vb;
+      try {
+        va = sim.simulate(ma, r, o.repeats, o.seed);
+        vb = sim.simulate(mb, r, o.repeats, o.seed);
+      } catch (const std::exception& e) {
+        say(std::string("suggestion skipped: ") + e.what());
+        continue;
+      }
+      for (const auto& [q, x] : va) {
+        if (!vb.count(q)) continue;
+        const double y = vb.at(q).mean;
+        const double rel = rel_std.count(q) ? rel_std[q] : 0.02;
+        const double sigma = std::hypot(rel * std::abs(x.mean), std::hypot(x.std, vb.at(q).std));
+        if (sigma <= 0) continue;
+        Suggestion s;
+        s.rig = r.rig;
+        s.sample = r.sample;
+        auto settings = r.settings;
+        settings.erase("scale");
+        s.setting = format_settings(settings);
+        s.quantity = q;
+        s.separation = std::abs(x.mean - y) / sigma;
+        s.between = a.candidate.effect + " vs " + b.candidate.effect;
+        d.suggestions.push_back(s);
+      }
+    }
+    std::sort(d.suggestions.begin(), d.suggestions.end(),
+              [](const Suggestion& x, const Suggestion& y) { return x.separation > y.separation; });
+  }
+  d.simulations = sim.runs() - runs0;
+  return d;
+}
+
+std::string Diagnosis::summary() const {
+  std::string s;
+  s += fmt::format("baseline: chi2 = {:.2f} for {} observables (chi2/dof {:.2f}, p = {:.3g})\n",
+                   baseline.chi2, baseline.observables.size(), baseline.chi2_per_dof, baseline_p);
+  if (consistent) {
+    s += fmt::format(
+        "verdict: the model is consistent with the data; no effect improves it decisively "
+        "(baseline weight {:.2f})\n",
+        confidence);
+  } else {
+    const CandidateResult& t = candidates.front();
+    s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}), confidence {:.2f}\n",
+                     verdict, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
+                     confidence);
+    if (!t.plausible)
+      s += "  warning: the fitted value is pinned at the edge of its physical range: the effect "
+           "it stands for may be the wrong one\n";
+    for (const auto& dr : drivers) s += "  driven by " + dr + "\n";
+    if (!indistinguishable.empty()) {
+      s += "  indistinguishable on these data from:";
+      for (const auto& e : indistinguishable) s += " " + e;
+      s += "\n";
+    }
+  }
+  if (!suggestions.empty()) {
+    const Suggestion& g = suggestions.front();
+    s += fmt::format("next measurement: {} sample {}{} {} separates {} by {:.1f} sigma\n", g.rig,
+                     g.sample, g.setting.empty() ? "" : " [" + g.setting + "]", g.quantity,
+                     g.between, g.separation);
+  }
+  return s;
+}
+
+}  // namespace clumpkit::calibrate

@@ -1,0 +1,219 @@
+#include "clumpkit/calibrate/effects.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <set>
+
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/fill/paper_rule.hpp"
+
+namespace clumpkit::calibrate {
+
+std::string EffectCandidate::format(double v) const {
+  if (discrete) {
+    for (size_t i = 0; i < levels.size(); ++i)
+      if (levels[i] == v) return level_names[i];
+    return fmt::format("{}", v);
+  }
+  return unit == "1" ? fmt::format("{:.4g}", v) : fmt::format("{:.4g} {}", v, unit);
+}
+
+namespace {
+
+ParticleModel with(const ParticleModel& base, const std::string& key, const std::string& value) {
+  ParticleModel m = base;
+  set_model_effect(m, key, value, "diagnosis");
+  return m;
+}
+
+double first_value(const std::optional<std::map<std::string, double>>& v, const std::string& k,
+                   double fallback) {
+  if (!v) return fallback;
+  auto it = v->find(k);
+  return it != v->end() ? it->second : (v->empty() ? fallback : v->begin()->second);
+}
+
+// A probe inside the range, a fixed step from the baseline, towards the range's middle.
+double probe_from(double base, double step, double lo, double hi) {
+  const double up = base + step, down = base - step;
+  if (up <= hi && (base <= 0.5 * (lo + hi) || down < lo)) return up;
+  return std::max(lo, down);
+}
+
+}  // namespace
+
+std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
+                                               const std::vector<std::string>& only,
+                                               std::vector<std::string>* skipped,
+                                               const std::string& where) {
+  for (const auto& e : only) check_effect_name(e, where, "");
+  auto wanted = [&](const std::string& e) {
+    return only.empty() || std::find(only.begin(), only.end(), e) != only.end();
+  };
+  auto skip = [&](const std::string& e, const std::string& why) {
+    if (skipped && wanted(e)) skipped->push_back(e + ": " + why);
+  };
+  const ModelEffects& fx = base.effects;
+  std::vector<EffectCandidate> out;
+
+  if (wanted("rolling_friction")) {
+    EffectCandidate c;
+    c.effect = "rolling_friction";
+    c.parameter = "mu_r, pill-pill and pill-wall";
+    c.unit = "1";
+    c.lo = 0.0;
+    c.hi = 0.5;
+    c.baseline = first_value(fx.rolling_friction, "pill", 0.0);
+    c.probe = probe_from(c.baseline, 0.08, c.lo, c.hi);
+    c.apply = [](const ParticleModel& m, double v) {
+      return with(m, "effects.rolling_friction", fmt::format("{:.17g}", v));
+    };
+    out.push_back(c);
+  }
+  if (wanted("particle_friction")) {
+    EffectCandidate c;
+    c.effect = "particle_friction";
+    c.parameter = "mu_s, pill-pill";
+    c.unit = "1";
+    c.lo = 0.0;
+    c.hi = 1.2;
+    c.baseline = fx.particle_friction.value_or(0.0);
+    c.probe = probe_from(c.baseline, 0.25, c.lo, c.hi);
+    c.apply = [](const ParticleModel& m, double v) {
+      return with(m, "effects.particle_friction", fmt::format("{:.17g}", v));
+    };
+    out.push_back(c);
+  }
+  if (wanted("wall_friction")) {
+    EffectCandidate c;
+    c.effect = "wall_friction";
+    c.parameter = "mu_s, pill-wall (all wall materials)";
+    c.unit = "1";
+    c.lo = 0.0;
+    c.hi = 1.2;
+    c.baseline = first_value(fx.wall_friction, "galvanized_steel", 0.0);
+    c.probe = probe_from(c.baseline, 0.25, c.lo, c.hi);
+    c.apply = [](const ParticleModel& m, double v) {
+      return with(m, "effects.wall_friction", fmt::format("{:.17g}", v));
+    };
+    out.push_back(c);
+  }
+  if (wanted("restitution")) {
+    EffectCandidate c;
+    c.effect = "restitution";
+    c.parameter = "e, all pairs";
+    c.unit = "1";
+    c.lo = 0.05;
+    c.hi = 1.0;
+    c.baseline = first_value(fx.restitution, "pill", 1.0);
+    c.probe = probe_from(c.baseline, 0.3, c.lo, c.hi);
+    c.apply = [](const ParticleModel& m, double v) {
+      return with(m, "effects.restitution", fmt::format("{:.17g}", v));
+    };
+    out.push_back(c);
+  }
+  if (wanted("cohesion")) {
+    EffectCandidate c;
+    c.effect = "cohesion";
+    c.parameter = "SJKR energy density, pill-pill";
+    c.unit = "J/m^3";
+    c.lo = 0.0;
+    c.hi = 5e4;
+    c.baseline = fx.cohesion.value_or(0.0);
+    c.probe = probe_from(c.baseline, 8e3, c.lo, c.hi);
+    c.apply = [](const ParticleModel& m, double v) {
+      return with(m, "effects.cohesion", fmt::format("{:.17g} J/m^3", v));
+    };
+    out.push_back(c);
+  }
+  if (wanted("shape_resolution")) {
+    // Sphere counts every paper-rule type of the model has a preset for.
+    std::set<int> common;
+    bool first = true, all_paper = !base.types.empty();
+    for (const auto& t : base.types) {
+      if (!t.paper_spheres && !fx.shape_resolution) all_paper = false;
+      const auto counts = paper_preset_counts(regime(t.shape.diameter, t.shape.height));
+      std::set<int> s(counts.begin(), counts.end());
+      if (first) common = s;
+      else {
+        std::set<int> x;
+        std::set_intersection(common.begin(), common.end(), s.begin(), s.end(),
+                              std::inserter(x, x.begin()));
+        common = x;
+      }
+      first = false;
+    }
+    const int current = fx.shape_resolution.value_or(
+        base.types.empty() ? 0 : base.types.front().paper_spheres.value_or(0));
+    common.erase(current);
+    if (!all_paper) {
+      skip("shape_resolution", "a type uses a clump template, not a paper rule");
+    } else if (common.empty()) {
+      skip("shape_resolution", "no other paper-rule sphere count fits every type");
+    } else {
+      EffectCandidate c;
+      c.effect = "shape_resolution";
+      c.parameter = "spheres per clump (paper rule)";
+      c.unit = "spheres";
+      c.discrete = true;
+      c.baseline = current;
+      for (int n : common) {
+        c.levels.push_back(n);
+        c.level_names.push_back(fmt::format("{} spheres", n));
+      }
+      c.lo = *common.begin();
+      c.hi = *common.rbegin();
+      c.apply = [](const ParticleModel& m, double v) {
+        return with(m, "effects.shape_resolution", fmt::format("{}", static_cast<int>(v)));
+      };
+      out.push_back(c);
+    }
+  }
+  if (wanted("rolling_model")) {
+    if (!fx.rolling_friction) {
+      skip("rolling_model", "needs rolling_friction on in the baseline");
+    } else {
+      EffectCandidate c;
+      c.effect = "rolling_model";
+      c.parameter = "rolling resistance model";
+      c.unit = "";
+      c.discrete = true;
+      const auto cur = fx.rolling_model.value_or(dem::RollingModel::kStandard);
+      c.baseline = static_cast<double>(static_cast<int>(cur));
+      for (auto m : {dem::RollingModel::kStandard, dem::RollingModel::kCdt, dem::RollingModel::kEpsd})
+        if (m != cur) {
+          c.levels.push_back(static_cast<int>(m));
+          c.level_names.push_back(std::string("rolling_model=") + dem::to_string(m));
+        }
+      c.lo = 0;
+      c.hi = 2;
+      c.apply = [](const ParticleModel& m, double v) {
+        return with(m, "effects.rolling_model",
+                    dem::to_string(static_cast<dem::RollingModel>(static_cast<int>(v))));
+      };
+      out.push_back(c);
+    }
+  }
+  if (wanted("size_distribution")) {
+    if (base.types.size() < 2) {
+      skip("size_distribution", "the model has a single pill type");
+    } else if (!fx.size_distribution) {
+      EffectCandidate c;
+      c.effect = "size_distribution";
+      c.parameter = "pill types at their mass fractions";
+      c.unit = "";
+      c.discrete = true;
+      c.baseline = 0;
+      c.levels = {1};
+      c.level_names = {"size_distribution on"};
+      c.apply = [](const ParticleModel& m, double) { return with(m, "effects.size_distribution", "on"); };
+      out.push_back(c);
+    } else {
+      skip("size_distribution", "already on; its fractions are fixed by the model file");
+    }
+  }
+  return out;
+}
+
+}  // namespace clumpkit::calibrate
