@@ -25,10 +25,10 @@ std::vector<ExportFile> render_liggghts(const ClumpTemplate& c, const ExportSett
   const Eigen::Matrix3d I = principal_inertia(c);
   std::string snip = provenance_block(c, "liggghts", "# ");
   snip += "#\n";
-  snip += "# Insert with: fix particledistribution/discrete SEED 1 pts_" + id +
-          " 1.0, then fix insert/pack (or insert/stream) with distributiontemplate, and\n"
-          "# exactly one 'fix ... multisphere'. The spheres file path is relative to the working\n"
-          "# folder of liggghts. The seed must be a prime above 10000.\n";
+  snip += "# Insert with: fix particledistribution/discrete SEED 1 pts_" + id + " 1.0,\n" +
+          "# then fix insert/pack (or insert/stream) with distributiontemplate, and exactly one\n"
+          "# 'fix ... multisphere'. The spheres file path is relative to the working folder of\n"
+          "# liggghts. Seeds must be primes above 10000.\n";
   snip +=
       "# Template frame: positions are relative to the union's centre of mass, along its\n"
       "# principal axes; inertia_tensor (Ixx Ixy Ixz Iyy Iyz Izz, kg m^2, about the centre of\n"
