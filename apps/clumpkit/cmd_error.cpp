@@ -195,9 +195,9 @@ void print_table(std::vector<Row>& rows) {
     std::cout << fmt::format(
         "{:<14} {:<10} {:>7} {:>15} {:>15} {:>9.4f} {:>+9.2f} {:>8} {:>9.4f} {:>9.4f}\n", r.name,
         shape_key(r), e.spheres,
-        fmt::format("{:+.2f} ± {:.2f}", 100 * e.volume_rel_error.value,
+        fmt::format("{:+.2f} ± {:.3f}", 100 * e.volume_rel_error.value,
                     100 * e.volume_rel_error.ci95),
-        fmt::format("{:.2f} ± {:.2f}", 100 * e.sym_diff_rel.value, 100 * e.sym_diff_rel.ci95),
+        fmt::format("{:.2f} ± {:.3f}", 100 * e.sym_diff_rel.value, 100 * e.sym_diff_rel.ci95),
         100 * e.com_offset_rel.value, 100 * worst,
         e.axis_angle_deg ? fmt::format("{:.2f}", *e.axis_angle_deg) : std::string("n/a"),
         e.hausdorff * 1e3, e.mean_surface_distance * 1e3);
