@@ -353,6 +353,72 @@ int World::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quaternion
   return impl_->add_clump(type, x, q, v, w);
 }
 
+int World::remove_clumps(const std::function<bool(int)>& remove) {
+  Impl& w = *impl_;
+  const int nc = static_cast<int>(w.c_x.size());
+  std::vector<int> clump_map(nc, -1);
+  int kept = 0;
+  for (int c = 0; c < nc; ++c)
+    if (!remove(c)) clump_map[c] = kept++;
+  if (kept == nc) return 0;
+  for (int c = 0; c < nc; ++c)
+    if (clump_map[c] < 0) {
+      const TypeData& t = w.types[w.c_type[c]];
+      // The energy they carried leaves the balance of the blow-up check with them.
+      w.check_energy -= 0.5 * t.mass * w.c_v[c].squaredNorm() +
+                        0.5 * w.c_wb[c].dot(t.inertia.cwiseProduct(w.c_wb[c])) -
+                        t.mass * w.settings.gravity.dot(w.c_x[c]);
+    }
+  auto compact = [&](auto& v, const std::vector<int>& map) {
+    size_t o = 0;
+    for (size_t k = 0; k < map.size(); ++k)
+      if (map[k] >= 0) v[o++] = v[k];
+    v.resize(o);
+  };
+  const int ns = static_cast<int>(w.s_r.size());
+  std::vector<int> sphere_map(ns, -1);
+  int ks = 0;
+  for (int s = 0; s < ns; ++s)
+    if (clump_map[w.s_clump[s]] >= 0) sphere_map[s] = ks++;
+  compact(w.c_type, clump_map);
+  compact(w.c_x, clump_map);
+  compact(w.c_v, clump_map);
+  compact(w.c_wb, clump_map);
+  compact(w.c_q, clump_map);
+  compact(w.c_R, clump_map);
+  compact(w.c_f, clump_map);
+  compact(w.c_t, clump_map);
+  compact(w.c_mroll, clump_map);
+  for (int s = 0; s < ns; ++s) w.s_clump[s] = clump_map[w.s_clump[s]];
+  compact(w.s_clump, sphere_map);
+  compact(w.s_r, sphere_map);
+  compact(w.s_off, sphere_map);
+  compact(w.s_pos, sphere_map);
+  compact(w.s_pos_build, sphere_map);
+  compact(w.wall_slots, sphere_map);
+  w.c_first.assign(kept, 0);
+  for (int s = ks - 1; s >= 0; --s) w.c_first[w.s_clump[s]] = s;
+  // Pair lists stay sorted under the monotone renumbering.
+  size_t o = 0;
+  for (size_t k = 0; k < w.pairs.size(); ++k) {
+    const int i = sphere_map[w.pairs[k].i], j = sphere_map[w.pairs[k].j];
+    if (i < 0 || j < 0) continue;
+    w.pairs[o] = {i, j};
+    w.pair_hist[o] = w.pair_hist[k];
+    ++o;
+  }
+  w.pairs.resize(o);
+  w.pair_hist.resize(o);
+  // Contacts of the last evaluation are dropped; wall candidates are rebuilt next step.
+  w.pair_contacts.clear();
+  w.wall_contacts.assign(ks, {});
+  w.wall_contact_n.assign(ks, 0);
+  w.wall_cand.clear();
+  w.wall_cand_start.assign(ks + 1, 0);
+  w.need_rebuild = true;
+  return nc - kept;
+}
+
 double World::Impl::kinetic_energy() const {
   double e = 0.0;
   for (size_t c = 0; c < c_x.size(); ++c) {

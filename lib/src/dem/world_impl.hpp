@@ -45,7 +45,8 @@ struct PairEntry {
 // Geometry of an active sphere-sphere contact (contacts stage) and its result (forces stage).
 struct PairContactData {
   int pair = 0;
-  Eigen::Vector3d normal, point;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double overlap = 0.0;
   ContactForce out;
 };
@@ -66,7 +67,8 @@ struct WallSlot {
 
 struct WallContactData {
   int wall = -1;
-  Eigen::Vector3d normal, point;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double overlap = 0.0;
   ContactForce out;
 };

@@ -125,6 +125,11 @@ class World {
                 const Eigen::Vector3d& v = Eigen::Vector3d::Zero(),
                 const Eigen::Vector3d& w = Eigen::Vector3d::Zero());
 
+  /// Removes every clump for which `remove(c)` is true (outlets, strike-off, particles that left
+  /// the domain); the others keep their order, state and contact histories. Indices of later
+  /// clumps shift down. Returns the number removed.
+  int remove_clumps(const std::function<bool(int)>& remove);
+
   int clump_count() const;
   long sphere_count() const;
   int clump_type_of(int c) const;
