@@ -61,10 +61,13 @@ TEST(RigGeometry, MeshesAreValidAndPlaced) {
   for (const auto& m : {wheel_mesh(g), housing_mesh(g), hopper_mesh(g), end_plates_mesh(g)}) {
     EXPECT_NO_THROW(m.validate("wheel rig", "mesh"));
   }
-  // The wheel lies inside the housing radius; the throat sits above the wheel.
-  for (const auto& v : wheel_mesh(g).vertices)
-    EXPECT_LE(std::hypot(v.x(), v.z()), g.outer_radius + 1e-9);
-  EXPECT_GT(g.throat_z(), g.outer_radius);
+  // The wheel (vane tips included) turns inside the housing; the hopper throat lies on the
+  // housing circle, outside the wheel.
+  const double tip = std::hypot(g.outer_radius, 0.5 * g.vane_thickness);
+  for (const auto& v : wheel_mesh(g).vertices) EXPECT_LE(std::hypot(v.x(), v.z()), tip + 1e-12);
+  EXPECT_LT(tip, g.outer_radius + g.housing_gap);
+  EXPECT_NEAR(std::hypot(0.5 * g.hopper_opening, g.throat_z()), g.outer_radius + g.housing_gap,
+              1e-12);
   const LiftingGeometry l;
   EXPECT_NO_THROW(lifting_cylinder_mesh(l).validate("tube", "mesh"));
   EXPECT_NO_THROW(plate_mesh(l).validate("plate", "mesh"));

@@ -111,7 +111,7 @@ TEST(Model, ErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("unknown effect"), std::string::npos) << e;
 
   e = error_of(std::string(kHead) + "[effects.rolling_friction]\npill = -0.1\n");
-  EXPECT_NE(e.find("test_model.toml:11"), std::string::npos) << e;
+  EXPECT_NE(e.find("test_model.toml:10"), std::string::npos) << e;
   EXPECT_NE(e.find("effects.rolling_friction.pill"), std::string::npos) << e;
 
   e = error_of(std::string(kHead) + "[effects.wall_friction]\nunobtainium = 0.3\n");

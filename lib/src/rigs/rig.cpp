@@ -33,13 +33,13 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
   if (p.name == "mini") {
     // Quick work: softer pills (a larger time step), a smaller cup, a smaller heap lifted
     // faster, a half-size wheel in a two-pill slice.
-    p.stiffness_scale = 0.02;
+    p.stiffness_scale = 0.05;
     p.rayleigh_fraction = 0.3;
     p.settle_speed = 0.01;
     p.settle_max = 1.0;
     p.cup_diameter = 0.040, p.cup_height = 0.0386;
     p.pour_rate = 0.3;
-    p.scraper_speed = 0.1;
+    p.scraper_speed = 0.04;
     p.tube_diameter = 0.050, p.tube_height = 0.150;
     p.plate_side = 0.3;
     p.heap_mass = 0.08;
@@ -376,8 +376,14 @@ RepeatResult bulk_density(Ctx& c) {
       pour(c, dem::CylinderRegion{Vector3d(0, 0, H + 0.005), fr, fh}, pour_mass));
   // The scraper waits beside the cup; phase 2 moves it across the rim.
   const double x_start = -(R + 0.012), x_end = R + 0.02;
+  double r_min = 1.0;
+  for (const auto& t : c.types)
+    for (const auto& sp : t.clump.spheres) r_min = std::min(r_min, sp.radius);
   auto scraper = [&](double t_on) {
-    dem::WallSettings s{"scraper", scraper_mesh(x_start, R + 0.02, H, 0.06), cup_material, {}, {}};
+    // The blade clears the rim by a fifth of the smallest sphere radius, so a pill half below
+    // the rim is rolled away rather than wedged between blade and bed.
+    dem::WallSettings s{
+        "scraper", scraper_mesh(x_start, R + 0.02, H + 0.2 * r_min, 0.06), cup_material, {}, {}};
     s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / p.scraper_speed,
                                          Vector3d(p.scraper_speed, 0, 0));
     return s;
