@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -39,7 +40,8 @@ CliRun run(const std::string& args) {
 class ErrorCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = fs::path(CLUMPKIT_BINARY_DIR) / "test_tmp" / "error_cli";
+    // One folder per process: CTest runs each test in its own process, possibly in parallel.
+    dir_ = fs::path(CLUMPKIT_BINARY_DIR) / "test_tmp" / ("error_cli_" + std::to_string(getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     ASSERT_EQ(
@@ -49,6 +51,7 @@ class ErrorCli : public ::testing::Test {
     ASSERT_EQ(run("fill pill_C --spheres 2 --rays 100000 -o " + (dir_ / "C2.json").string()).status,
               0);
   }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
   static std::string path(const std::string& f) { return (dir_ / f).string(); }
   static void write(const std::string& f, const std::string& text) {
     std::ofstream(dir_ / f) << text;
