@@ -350,7 +350,13 @@ int World::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quaternion
     throw InputError(impl_->settings.source, "clump type", "index out of range");
   if (!x.allFinite() || !v.allFinite() || !w.allFinite() || !q.coeffs().allFinite())
     throw InputError(impl_->settings.source, "clump state", "non-finite value");
-  return impl_->add_clump(type, x, q, v, w);
+  const int c = impl_->add_clump(type, x, q, v, w);
+  // Energy brought in by hand counts as a source in the blow-up check's balance.
+  const TypeData& t = impl_->types[type];
+  impl_->inserted_energy += 0.5 * t.mass * v.squaredNorm() +
+                            0.5 * impl_->c_wb[c].dot(t.inertia.cwiseProduct(impl_->c_wb[c])) -
+                            t.mass * impl_->settings.gravity.dot(x);
+  return c;
 }
 
 int World::remove_clumps(const std::function<bool(int)>& remove) {
@@ -522,10 +528,16 @@ Eigen::Vector3d World::omega_world(int c) const {
   return impl_->c_R[c] * impl_->c_wb[c];
 }
 void World::set_velocity(int c, const Eigen::Vector3d& v) {
+  const double m = impl_->types[impl_->c_type[c]].mass;
+  impl_->inserted_energy += 0.5 * m * (v.squaredNorm() - impl_->c_v[c].squaredNorm());
   impl_->c_v[c] = v;
 }
 void World::set_omega_world(int c, const Eigen::Vector3d& w) {
-  impl_->c_wb[c] = impl_->c_R[c].transpose() * w;
+  const Eigen::Vector3d& inertia = impl_->types[impl_->c_type[c]].inertia;
+  const Eigen::Vector3d wb = impl_->c_R[c].transpose() * w;
+  impl_->inserted_energy += 0.5 * (wb.dot(inertia.cwiseProduct(wb)) -
+                                   impl_->c_wb[c].dot(inertia.cwiseProduct(impl_->c_wb[c])));
+  impl_->c_wb[c] = wb;
 }
 const std::vector<Eigen::Vector3d>& World::contact_forces() const {
   return impl_->c_f;

@@ -57,8 +57,10 @@ struct WorldSettings {
   /// least 10 steps (InputError below 4, warning below 10). At 0.2 T_R a 2 m/s pill-pill
   /// impact spans about 14 steps.
   double max_impact_speed = 2.0;
-  double skin = 0.0;       ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
-  int threads = 0;         ///< OpenMP threads; 0 = all
+  double skin = 0.0;  ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
+  /// OpenMP threads; 0 = auto: all cores from 20 000 spheres on, one thread below (see
+  /// docs/dem.md). Results are bit-identical for any thread count.
+  int threads = 0;
   std::uint64_t seed = 1;  ///< factories' random stream
 
   /// Blow-up detection: checked every `check_interval` steps.
@@ -139,6 +141,7 @@ class World {
   const std::vector<Eigen::Vector3d>& velocities() const;       ///< m/s
   const std::vector<Eigen::Vector3d>& omegas_body() const;      ///< rad/s, principal frame
   Eigen::Vector3d omega_world(int c) const;                     ///< rad/s
+  /// Changes by hand count as an energy source in the blow-up check.
   void set_velocity(int c, const Eigen::Vector3d& v);
   void set_omega_world(int c, const Eigen::Vector3d& w);
   /// Net contact force / torque on each clump from the last evaluation (no gravity), world frame.
