@@ -182,3 +182,34 @@ TEST(Walls, BadMeshIsAnInputError) {
 
 }  // namespace
 }  // namespace clumpkit::dem
+
+namespace clumpkit::dem {
+namespace {
+
+// A flat 3 × 3 slab on a turntable (10 rpm about z) is carried round by friction: it ends up
+// moving with the table, v = Ω × x and ω_z = Ω.
+TEST(Walls, TurntableCarriesASlab) {
+  WorldSettings s;
+  s.materials = test::test_materials(0.3, 0.6, 0.0);
+  const double r = 1e-3;
+  Spheres sp;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j) sp.push_back({Eigen::Vector3d(2 * r * i, 2 * r * j, 0), r});
+  const double m = 9.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r * 1380.0;
+  const double ixy = m * 2.0 * r * r;
+  s.clump_types.push_back(test::clump_type("slab", sp, m, Eigen::Vector3d(ixy, ixy, 2 * ixy)));
+  WallSettings table = test::floor_wall(0.1, 8);
+  table.motion.rotation = WallRotation{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 10.0};
+  s.walls.push_back(table);
+  World w = World::create(s);
+  w.add_clump(0, Eigen::Vector3d(0.02, 0, r));
+  w.run_until(0.3);
+  const double omega = 10.0 * 2.0 * std::numbers::pi / 60.0;
+  const Eigen::Vector3d expected = Eigen::Vector3d(0, 0, omega).cross(w.positions()[0]);
+  EXPECT_NEAR((w.velocities()[0] - expected).norm(), 0.0, 0.01 * expected.norm());
+  EXPECT_NEAR(w.omega_world(0).z(), omega, 0.01 * omega);
+  EXPECT_NEAR(w.positions()[0].head<2>().norm(), 0.02, 1e-4);
+}
+
+}  // namespace
+}  // namespace clumpkit::dem
