@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli_util.hpp"
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/geometry/clump_template.hpp"
 
 namespace clumpkit::cli {
@@ -20,12 +21,19 @@ Command setup(CLI::App& parent) {
   c->add_option("CLUMP", args->clump, "Clump template (.json)")->required();
   c->add_option("--json", args->json, "Also write the template's summary as JSON (FILE or -)");
   return {c, [args] {
+            if (!args->json.empty() && args->json != "-") check_writable(args->json, "--json");
             const ClumpTemplate t = load_clump(args->clump);
             const MassProperties& m = t.mass;
             std::cout << fmt::format("clump      {}\n", t.name.empty() ? args->clump : t.name);
+            // Provenance is free-form JSON: print non-strings as JSON rather than fail.
+            const auto text = [](const nlohmann::json& j, const char* key) {
+              const auto it = j.find(key);
+              if (it == j.end()) return std::string();
+              return it->is_string() ? it->get<std::string>() : it->dump();
+            };
             if (t.source.contains("shape"))
-              std::cout << fmt::format("source     {} ({})\n", t.source.value("shape", ""),
-                                       t.source.value("kind", ""));
+              std::cout << fmt::format("source     {} ({})\n", text(t.source, "shape"),
+                                       text(t.source, "kind"));
             if (t.method.contains("name"))
               std::cout << fmt::format("method     {}\n", t.method.dump());
             std::cout << fmt::format("spheres    {}\n", t.spheres.size());

@@ -30,6 +30,7 @@ Command setup(CLI::App& parent) {
       ->check(CLI::PositiveNumber);
   return {c, [args] {
             namespace fs = std::filesystem;
+            if (!args->json.empty() && args->json != "-") check_writable(args->json, "--json");
             if (!args->out.empty()) {
               std::error_code ec;
               fs::create_directories(args->out, ec);

@@ -21,8 +21,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // One line, like every other input error (CLI11's own report takes two).
+    std::cerr << "clumpkit: error: " << InputError(e.what()).what()
+              << " (run with --help for usage)\n";
+    return 2;
   }
   try {
     for (const auto& c : commands)

@@ -1,5 +1,6 @@
 #include "clumpkit/core/materials.hpp"
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/core/toml_doc.hpp"
 
@@ -48,7 +49,11 @@ std::vector<std::string> MaterialLibrary::names() const {
 }
 
 MaterialLibrary MaterialLibrary::load(const std::filesystem::path& path) {
-  TomlDoc doc = TomlDoc::load(path);
+  return parse(read_file(path), path.string());
+}
+
+MaterialLibrary MaterialLibrary::parse(const std::string& text, const std::string& where) {
+  TomlDoc doc = TomlDoc::parse(text, where);
   MaterialLibrary lib;
   for (const std::string& name : doc.keys("materials")) {
     const std::string p = "materials." + name + ".";
@@ -62,13 +67,13 @@ MaterialLibrary MaterialLibrary::load(const std::filesystem::path& path) {
     doc.require_range(p + "youngs_modulus", m.youngs_modulus, 0.0, 1e13, true);
     lib.add(m);
   }
-  if (lib.materials_.empty()) throw InputError(path.string(), "materials", "no materials defined");
+  if (lib.materials_.empty()) throw InputError(where, "materials", "no materials defined");
   const size_t n = doc.array_size("interactions");
   for (size_t k = 0; k < n; ++k) {
     const std::string p = "interactions." + std::to_string(k) + ".";
     auto pair = doc.strings(p + "pair");
     if (pair.size() != 2) doc.fail(p + "pair", "expected two material names");
-    for (const auto& name : pair) lib.get(name, path.string(), p + "pair");
+    for (const auto& name : pair) lib.get(name, where, p + "pair");
     Interaction i;
     i.restitution = doc.number(p + "restitution");
     doc.require_range(p + "restitution", i.restitution, 0.0, 1.0, true, false);

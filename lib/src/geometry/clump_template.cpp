@@ -151,10 +151,18 @@ ClumpTemplate clump_from_json(const json& j, const std::string& where) {
                                  "mass_properties.principal_moments");
   if ((m.principal_moments.array() <= 0).any())
     throw InputError(where, "mass_properties.principal_moments", "must be positive");
-  if (auto it = mp.find("method"); it != mp.end()) c.mass_method = *it;
+  if (auto it = mp.find("method"); it != mp.end()) {
+    if (!it->is_object()) throw InputError(where, "mass_properties.method", "expected an object");
+    c.mass_method = *it;
+  }
   if (auto it = mp.find("basis"); it != mp.end()) c.mass_method["basis"] = *it;
+  if (auto it = c.mass_method.find("basis"); it == c.mass_method.end())
+    c.mass_method["basis"] = "sphere_union";  // what to_json states when none is recorded
+  else if (!it->is_string())
+    throw InputError(where, "mass_properties.basis", "expected a string");
   if (auto it = mp.find("ci95"); it != mp.end() && it->is_object()) {
-    c.mass_ci.volume = it->value("volume", 0.0);
+    if (auto v = it->find("volume"); v != it->end())
+      c.mass_ci.volume = num(*v, where, "mass_properties.ci95.volume");
   }
   const json& fr = member(j, "frame", where, "");
   c.rotation = read_mat(member(fr, "rotation", where, "frame"), where, "frame.rotation");
@@ -162,6 +170,10 @@ ClumpTemplate clump_from_json(const json& j, const std::string& where) {
   if (!(c.rotation * c.rotation.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
       c.rotation.determinant() < 0)
     throw InputError(where, "frame.rotation", "is not a proper rotation matrix");
+  // Provenance is free-form, but tables: commands look names up in them.
+  for (const char* key : {"source", "method"})
+    if (auto it = j.find(key); it != j.end() && !it->is_object())
+      throw InputError(where, key, "expected an object");
   if (auto it = j.find("source"); it != j.end()) c.source = *it;
   if (auto it = j.find("method"); it != j.end()) c.method = *it;
   if (auto it = j.find("error"); it != j.end()) c.error = *it;
@@ -169,14 +181,24 @@ ClumpTemplate clump_from_json(const json& j, const std::string& where) {
 }
 
 ClumpTemplate load_clump(const std::filesystem::path& path) {
-  const std::string text = read_file(path);
+  return parse_clump(read_file(path), path.string());
+}
+
+ClumpTemplate parse_clump(const std::string& text, const std::string& where) {
+  // Nesting deeper than any template needs would only make copying and printing recurse deeply.
+  constexpr int kMaxDepth = 64;
+  const json::parser_callback_t limit_depth = [&](int depth, json::parse_event_t, json&) {
+    if (depth > kMaxDepth)
+      throw InputError(where, "", "JSON nested deeper than " + std::to_string(kMaxDepth));
+    return true;
+  };
   json j;
   try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw InputError(path.string(), "", std::string("not valid JSON: ") + e.what());
+    j = json::parse(text, limit_depth);
+  } catch (const json::exception& e) {  // syntax errors, and numbers such as 1e999 (out_of_range)
+    throw InputError(where, "", std::string("not valid JSON: ") + e.what());
   }
-  return clump_from_json(j, path.string());
+  return clump_from_json(j, where);
 }
 
 void save_clump(const ClumpTemplate& c, const std::filesystem::path& path) {

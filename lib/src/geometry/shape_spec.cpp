@@ -1,12 +1,17 @@
 #include "clumpkit/geometry/shape_spec.hpp"
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/core/toml_doc.hpp"
 
 namespace clumpkit {
 
 ShapeSpec load_shape(const std::filesystem::path& path) {
-  TomlDoc doc = TomlDoc::load(path);
+  return parse_shape(read_file(path), path);
+}
+
+ShapeSpec parse_shape(const std::string& text, const std::filesystem::path& path) {
+  TomlDoc doc = TomlDoc::parse(text, path.string());
   ShapeSpec s;
   s.path = path;
   s.name = doc.string_opt("shape.name").value_or(path.stem().string());

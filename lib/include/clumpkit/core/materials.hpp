@@ -29,6 +29,8 @@ class MaterialLibrary {
  public:
   /// Loads `path`; throws InputError naming file, line and key on bad or missing values.
   static MaterialLibrary load(const std::filesystem::path& path);
+  /// The same from a file's text; `where` names the file in errors.
+  static MaterialLibrary parse(const std::string& text, const std::string& where);
   /// The paper's Table 1 (pill, abs_plastic, organic_glass, galvanized_steel), built in.
   static MaterialLibrary paper_table1();
 

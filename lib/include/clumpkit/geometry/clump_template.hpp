@@ -47,6 +47,8 @@ nlohmann::json to_json(const ClumpTemplate& c);
 ClumpTemplate clump_from_json(const nlohmann::json& j, const std::string& where);
 
 ClumpTemplate load_clump(const std::filesystem::path& path);
+/// The same from a file's text; `where` names the file in errors.
+ClumpTemplate parse_clump(const std::string& text, const std::string& where);
 /// Atomic write (temporary file + rename).
 void save_clump(const ClumpTemplate& c, const std::filesystem::path& path);
 

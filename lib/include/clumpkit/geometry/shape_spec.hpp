@@ -22,6 +22,8 @@ struct ShapeSpec {
 /// Loads a shape file; throws InputError naming file, line and key on anything missing, negative
 /// or zero.
 ShapeSpec load_shape(const std::filesystem::path& path);
+/// The same from the file's text (`path` names it in errors and resolves relative mesh files).
+ShapeSpec parse_shape(const std::string& text, const std::filesystem::path& path);
 
 /// A cylinder shape built in code.
 ShapeSpec cylinder_shape(const std::string& name, double diameter, double height, double density);
