@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <set>
 #include <sstream>
 
@@ -140,6 +141,8 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
   const std::string key = fmt::format("{}|{}|{}|{}", req.key(), seed, repeats, fp);
   const std::string id = fmt::format("{:016x}", std::hash<std::string>{}(key));
   const fs::path file = opt_.cache_dir / (req.rig + "_" + id + ".json");
+  const fs::path run_dir = opt_.cache_dir / ("run_" + req.rig + "_" + id);
+  folders_.push_back(run_dir);
   std::error_code ec;
   if (fs::exists(file, ec)) {
     try {
@@ -164,7 +167,7 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
   rr.seed = seed;
   rr.threads = opt_.threads;
   rr.rays = opt_.rays;
-  rr.out = opt_.cache_dir / ("run_" + req.rig + "_" + id);
+  rr.out = run_dir;
   rr.progress = opt_.progress;
   if (opt_.progress)
     opt_.progress(fmt::format("simulating {} sample {} [{}] model {} x{}", req.rig, req.sample,
@@ -185,6 +188,19 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
   for (const auto& [q, x] : v) values[q] = {{"mean", x.mean}, {"std", x.std}, {"n", x.n}};
   write_file_atomic(file, json{{"key", key}, {"values", values}, {"result", r.to_json()}}.dump(1));
   return v;
+}
+
+std::vector<fs::path> RigSimulator::pictures() const {
+  std::vector<fs::path> out;
+  std::set<fs::path> seen;
+  for (const auto& d : folders_) {
+    std::error_code ec;
+    if (!seen.insert(d).second || !fs::is_directory(d, ec)) continue;
+    for (const auto& e : fs::recursive_directory_iterator(d, ec))
+      if (e.path().extension() == ".png") out.push_back(e.path());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 }  // namespace clumpkit::calibrate

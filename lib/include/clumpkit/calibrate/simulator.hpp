@@ -71,10 +71,13 @@ class RigSimulator final : public Simulator {
   SimValues simulate(const ParticleModel& model, const SimRequest& request, int repeats,
                      std::uint64_t seed) override;
   long cache_hits() const { return hits_; }
+  /// PNG pictures (heap silhouettes, discharge curves) of the runs served so far.
+  std::vector<std::filesystem::path> pictures() const;
 
  private:
   Options opt_;
   long hits_ = 0;
+  std::vector<std::filesystem::path> folders_;
 };
 
 /// Converts a rig result's SI statistics to canonical-unit simulated values per quantity.
