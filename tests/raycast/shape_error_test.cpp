@@ -162,6 +162,35 @@ TEST(ShapeError, BadInputIsRefused) {
   EXPECT_THROW(shape_error(shape, {{Eigen::Vector3d::Zero(), 0.001}}, o), InputError);
 }
 
+TEST(SphereUnionSurface, EnclosedVoidWallsAreNotOuterSurface) {
+  // Six spheres on the axes enclose a void around the origin (the diagonal direction is blocked
+  // at 0.816 < 0.9 from the centres); the origin is outside every sphere.
+  Spheres s;
+  for (int k = 0; k < 3; ++k)
+    for (double sign : {-1.0, 1.0}) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      c[k] = sign;
+      s.push_back({c, 0.9});
+    }
+  const SphereUnionSurface surf(s);
+  std::size_t dropped = 0;
+  const auto outer = surf.sample_outer_surface(20000, 5, &dropped);
+  const auto all = surf.sample_surface(20000, 5);
+  EXPECT_GT(dropped, 0u);
+  double rmin_outer = 1e300, rmin_all = 1e300;
+  for (const auto& p : outer) rmin_outer = std::min(rmin_outer, p.norm());
+  for (const auto& p : all) rmin_all = std::min(rmin_all, p.norm());
+  // Void walls lie within ~0.1 of the origin (the sphere surfaces nearest to it); the outer
+  // surface nowhere comes that close.
+  EXPECT_LT(rmin_all, 0.2);
+  EXPECT_GT(rmin_outer, 0.9);
+  // No void: nothing dropped.
+  const SphereUnionSurface two(
+      {{Eigen::Vector3d(0, 0, 0), 1.0}, {Eigen::Vector3d(1.5, 0, 0), 0.8}});
+  two.sample_outer_surface(5000, 1, &dropped);
+  EXPECT_EQ(dropped, 0u);
+}
+
 TEST(SphereUnionSurface, DistanceMatchesBruteForceProperty) {
   // Random unions; random points inside and outside. The exact distance can never exceed the
   // distance to any sampled boundary point, and dense sampling must come close to it.

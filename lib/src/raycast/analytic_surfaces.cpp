@@ -119,8 +119,42 @@ double SphereUnionSurface::surface_distance(const Eigen::Vector3d& p) const {
   return std::isfinite(best) ? best : -outside;
 }
 
+bool SphereUnionSurface::escapes(const Eigen::Vector3d& q, int i) const {
+  const Spheres& s = union_.spheres();
+  const Eigen::Vector3d nrm = (q - s[i].center) / s[i].radius;
+  const Eigen::Vector3d p = q + 1e3 * tol_ * nrm;  // just outside, clear of round-off
+  auto free = [&](const Eigen::Vector3d& d) {
+    for (const Sphere& sp : s) {
+      const Eigen::Vector3d w = sp.center - p;
+      const double tc = w.dot(d);
+      if (tc > 0 && w.squaredNorm() - tc * tc < sp.radius * sp.radius) return false;
+    }
+    return true;
+  };
+  if (free(nrm)) return true;
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const Eigen::Vector3d d = Eigen::Vector3d(dx, dy, dz).normalized();
+        if (d.dot(nrm) > 0 && free(d)) return true;
+      }
+  return false;
+}
+
 std::vector<Eigen::Vector3d> SphereUnionSurface::sample_surface(std::size_t n,
                                                                 std::uint64_t seed) const {
+  return sample(n, seed, false, nullptr);
+}
+
+std::vector<Eigen::Vector3d> SphereUnionSurface::sample_outer_surface(std::size_t n,
+                                                                      std::uint64_t seed,
+                                                                      std::size_t* dropped) const {
+  return sample(n, seed, true, dropped);
+}
+
+std::vector<Eigen::Vector3d> SphereUnionSurface::sample(std::size_t n, std::uint64_t seed,
+                                                        bool outer, std::size_t* dropped) const {
   const Spheres& s = union_.spheres();
   std::vector<double> cdf;
   double total = 0.0;
@@ -131,13 +165,20 @@ std::vector<Eigen::Vector3d> SphereUnionSurface::sample_surface(std::size_t n,
   // Uniform on the sum of sphere areas, keeping the points no other sphere covers: uniform on
   // the boundary. The boundary is never empty, but bound the work all the same.
   const std::size_t max_tries = 1000 * n + 1000;
+  std::size_t lost = 0;
   for (std::size_t tries = 0; pts.size() < n && tries < max_tries; ++tries) {
     const double a = rng.uniform() * total;
     const int i = static_cast<int>(std::min<std::size_t>(
         std::upper_bound(cdf.begin(), cdf.end(), a) - cdf.begin(), s.size() - 1));
     const Eigen::Vector3d q = s[i].center + s[i].radius * unit_direction(rng);
-    if (on_boundary(q, i, -1, -1)) pts.push_back(q);
+    if (!on_boundary(q, i, -1, -1)) continue;
+    if (outer && !escapes(q, i)) {
+      ++lost;
+      continue;
+    }
+    pts.push_back(q);
   }
+  if (dropped) *dropped = lost;
   return pts;
 }
 

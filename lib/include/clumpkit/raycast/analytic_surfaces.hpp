@@ -37,10 +37,19 @@ class SphereUnionSurface final : public SurfaceSolid {
   double surface_distance(const Eigen::Vector3d& p) const override;
   /// Area-uniform points on the union's boundary (rejection from the spheres' surfaces).
   std::vector<Eigen::Vector3d> sample_surface(std::size_t n, std::uint64_t seed) const override;
+  /// As sample_surface, but only on the outer boundary: a point is dropped as the wall of an
+  /// enclosed void when none of 27 rays from it (its normal, and the 26 axis and diagonal
+  /// directions pointing away from its sphere) escapes the union. A heuristic: a deep, narrow
+  /// pocket of the outer surface can be taken for a void. `dropped` counts the dropped points.
+  std::vector<Eigen::Vector3d> sample_outer_surface(std::size_t n, std::uint64_t seed,
+                                                    std::size_t* dropped = nullptr) const;
   const Spheres& spheres() const { return union_.spheres(); }
 
  private:
   bool on_boundary(const Eigen::Vector3d& q, int skip_a, int skip_b, int skip_c) const;
+  bool escapes(const Eigen::Vector3d& q, int sphere) const;
+  std::vector<Eigen::Vector3d> sample(std::size_t n, std::uint64_t seed, bool outer,
+                                      std::size_t* dropped) const;
 
   SphereUnion union_;
   struct Circle {

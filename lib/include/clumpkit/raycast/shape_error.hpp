@@ -45,7 +45,10 @@ struct ShapeError {
   double hausdorff = 0.0;              ///< max of both directed maxima, m (sampled: a lower bound)
   double mean_surface_distance = 0.0;  ///< mean of both directed means, m
   double shape_to_clump_max = 0.0, shape_to_clump_mean = 0.0;  ///< from shape surface points, m
-  double clump_to_shape_max = 0.0, clump_to_shape_mean = 0.0;  ///< from union surface points, m
+  /// From points on the union's outer surface, m (walls of enclosed voids left out).
+  double clump_to_shape_max = 0.0, clump_to_shape_mean = 0.0;
+  /// Share of the union's boundary area that walls enclosed voids (left out above).
+  double void_wall_fraction = 0.0;
   std::size_t spheres = 0;
   std::int64_t rays = 0;
   int replicates = 0;
