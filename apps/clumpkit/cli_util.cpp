@@ -24,6 +24,18 @@ fs::path resolve_shape(const std::string& arg) {
                                 (data_dir() / "shapes").string() + ")");
 }
 
+fs::path find_model(const std::string& arg, const std::string& field) {
+  std::error_code ec;
+  if (fs::exists(arg, ec) && fs::is_regular_file(arg, ec)) return arg;
+  const fs::path dir = data_dir() / "shapes" / "models";
+  for (const fs::path& cand : {dir / (arg + ".toml"), dir / arg})
+    if (fs::exists(cand, ec)) return cand;
+  std::string known;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path().extension() == ".toml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
+  throw InputError("", field, "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
+}
+
 void write_json(const nlohmann::json& j, const std::string& target) {
   const std::string text = j.dump(2) + "\n";
   if (target == "-") {

@@ -13,6 +13,10 @@ std::filesystem::path data_dir();
 /// Resolves a shape argument: an existing path, or a bundled name ("pill_A" -> shapes/pill_A.toml).
 std::filesystem::path resolve_shape(const std::string& arg);
 
+/// Resolves a model argument: an existing file, or a bundled model name
+/// ("production" -> shapes/models/production.toml). Throws InputError naming `field`.
+std::filesystem::path find_model(const std::string& arg, const std::string& field = "--model");
+
 /// Writes JSON to a file (atomically) or to stdout for "-".
 void write_json(const nlohmann::json& j, const std::string& target);
 

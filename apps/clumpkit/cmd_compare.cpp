@@ -1,0 +1,327 @@
+// clumpkit compare / diagnose / synth: the model against measurements (issue: compare, diagnose,
+// add the missing effect, watch the error fall).
+#ifdef CLUMPKIT_HAVE_CALIBRATE
+#include <fmt/format.h>
+
+#include <iostream>
+#include <random>
+
+#include "cli_util.hpp"
+#include "clumpkit/calibrate/diagnosis.hpp"
+#include "clumpkit/calibrate/model_writer.hpp"
+#include "clumpkit/calibrate/report.hpp"
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+
+namespace clumpkit::cli {
+namespace {
+
+using namespace clumpkit::calibrate;
+using nlohmann::json;
+
+struct CalArgs {
+  std::vector<std::string> models;
+  std::string measurements, scale = "mini", json, report, cache = "clumpkit_cache", output;
+  std::string effects;
+  int repeats = 2, threads = 0;
+  std::uint64_t seed = 1;
+  bool apply = false, quiet = false, no_suggest = false;
+  double noise = 0.03;
+};
+
+void common_options(CLI::App* c, CalArgs& a) {
+  c->add_option("--scale", a.scale, "Rig scale: mini | small | paper")
+      ->check(CLI::IsMember({"mini", "small", "paper"}))
+      ->capture_default_str();
+  c->add_option("--repeats", a.repeats, "Simulation repeats (different seeds) per rig setting")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  c->add_option("--seed", a.seed, "Seed of the first repeat")->capture_default_str();
+  c->add_option("--cache", a.cache, "Folder of cached rig results (nothing is simulated twice)")
+      ->capture_default_str();
+  c->add_option("--threads", a.threads, "Threads per rig run (0 = all)");
+  c->add_option("--json", a.json, "Write the result as JSON (FILE or -)");
+  c->add_flag("--quiet", a.quiet, "No progress lines");
+}
+
+RigSimulator make_sim(const CalArgs& a) {
+  RigSimulator::Options o;
+  o.cache_dir = a.cache;
+  o.threads = a.threads;
+  if (!a.quiet) o.progress = [](const std::string& s) { std::cerr << "clumpkit: " << s << "\n"; };
+  return RigSimulator(o);
+}
+
+json comparison_json(const Comparison& c) {
+  json obs = json::array();
+  for (const auto& o : c.observables)
+    obs.push_back({{"rig", o.measured.rig},
+                   {"sample", o.measured.sample},
+                   {"setting", o.measured.setting_text()},
+                   {"quantity", o.measured.quantity},
+                   {"unit", o.measured.unit},
+                   {"measured", o.measured.value},
+                   {"measured_std", o.measured.std},
+                   {"measured_n", o.measured.n},
+                   {"simulated", o.simulated.mean},
+                   {"simulated_std", o.simulated.std},
+                   {"simulated_n", o.simulated.n},
+                   {"difference", o.difference},
+                   {"z", o.z},
+                   {"rel_error", o.rel_error},
+                   {"pass", o.pass}});
+  return {{"observables", obs}, {"chi2", c.chi2}, {"dof", c.dof}, {"chi2_per_dof", c.chi2_per_dof}};
+}
+
+void print_comparison(const std::string& model, const Comparison& c) {
+  std::cout << fmt::format("model {}\n", model);
+  std::cout << fmt::format("{:<16} {:<4} {:<26} {:<15} {:>10} {:>9} {:>10} {:>9} {:>7} {:>8} {}\n",
+                           "rig", "smp", "setting", "quantity", "measured", "+/-", "simulated",
+                           "+/-", "z", "rel", "pass");
+  for (const auto& o : c.observables)
+    std::cout << fmt::format(
+        "{:<16} {:<4} {:<26} {:<15} {:>10.4g} {:>9.2g} {:>10.4g} {:>9.2g} {:>+7.2f} {:>+7.1f}% "
+        "{} [{}]\n",
+        o.measured.rig, o.measured.sample, o.measured.setting_text(), o.measured.quantity,
+        o.measured.value, o.measured.std, o.simulated.mean, o.simulated.std, o.z,
+        100 * o.rel_error, o.pass ? "yes" : "NO ", o.measured.unit);
+  std::cout << fmt::format("chi2 = {:.2f}, dof = {}, chi2/dof = {:.2f}\n", c.chi2, c.dof,
+                           c.chi2_per_dof);
+}
+
+void check_outputs(const CalArgs& a) {
+  if (!a.json.empty() && a.json != "-") check_writable(a.json, "--json");
+  if (!a.report.empty()) {
+    std::error_code ec;
+    if (std::filesystem::exists(a.report, ec) && !std::filesystem::is_directory(a.report, ec))
+      throw InputError(a.report, "--report", "exists and is not a folder");
+    check_writable(std::filesystem::path(a.report) / "index.html", "--report");
+  }
+}
+
+Command setup_compare(CLI::App& parent) {
+  auto a = std::make_shared<CalArgs>();
+  CLI::App* c = parent.add_subcommand(
+      "compare", "Run every rig and setting the measurements need and compare: measured and "
+                 "simulated mean +/- std, z, relative error, pass (|z| <= 2), chi2/dof");
+  c->add_option("--model", a->models, "Model file or bundled name; repeat for a chain of model "
+                                      "versions (the report shows chi2/dof per version)")
+      ->required();
+  c->add_option("--measurements", a->measurements, "Measurement CSV (rig,sample,setting,quantity,"
+                                                   "value,std,n,unit)")
+      ->required();
+  c->add_option("--report", a->report, "Write a self-contained HTML report into this folder");
+  common_options(c, *a);
+  return {c, [a] {
+            const auto ms = load_measurements(a->measurements);  // validated before any run
+            std::vector<ParticleModel> models;
+            for (const auto& m : a->models) models.push_back(load_model(find_model(m), data_dir()));
+            if (!a->report.empty()) {
+              std::error_code ec;
+              std::filesystem::create_directories(a->report, ec);
+            }
+            check_outputs(*a);
+            RigSimulator sim = make_sim(*a);
+            ReportInput rep;
+            json chain = json::array();
+            for (const auto& m : models) {
+              const auto s = simulate_measurements(sim, m, ms, a->scale, a->repeats, a->seed);
+              const Comparison cmp = compare(ms, s);
+              print_comparison(m.name, cmp);
+              rep.chain.emplace_back(m.name, cmp);
+              json j = comparison_json(cmp);
+              j["model"] = m.name;
+              chain.push_back(j);
+            }
+            std::cout << fmt::format("{} rig runs simulated, {} served from the cache ({})\n",
+                                     sim.runs(), sim.cache_hits(), a->cache);
+            if (!a->json.empty()) {
+              json out = chain.back();
+              out["scale"] = a->scale;
+              out["repeats"] = a->repeats;
+              if (chain.size() > 1) out["chain"] = chain;
+              write_json(out, a->json);
+            }
+            if (!a->report.empty()) {
+              rep.pictures = sim.pictures();
+              write_report(rep, a->report);
+              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string() << "\n";
+            }
+            return 0;
+          }};
+}
+
+Command setup_diagnose(CLI::App& parent) {
+  auto a = std::make_shared<CalArgs>();
+  CLI::App* c = parent.add_subcommand(
+      "diagnose",
+      "Find the physical effect the model lacks: fit each candidate effect (SPEC §8) to the "
+      "measurements with real rig runs, rank by BIC, say which observables drive it, which "
+      "effects are indistinguishable and which measurement would separate them");
+  c->add_option("--model", a->models, "Baseline model file or bundled name")->required()->expected(1);
+  c->add_option("--measurements", a->measurements, "Measurement CSV")->required();
+  c->add_option("--effects", a->effects, "Comma-separated effect ids to try (default: all)");
+  c->add_option("--report", a->report, "Write a self-contained HTML report into this folder");
+  c->add_flag("--apply", a->apply, "Write the model with the winning effect at its fitted value");
+  c->add_option("-o,--output", a->output, "With --apply: the new model file (.toml)");
+  c->add_flag("--no-suggest", a->no_suggest, "Skip simulating unmeasured settings for the "
+                                              "next-measurement suggestion");
+  common_options(c, *a);
+  return {c, [a] {
+            const auto ms = load_measurements(a->measurements);
+            if (ms.size() < 3)
+              throw InputError(a->measurements, "",
+                               fmt::format("{} observable(s) are too few to tell effects apart "
+                                           "(need at least 3)", ms.size()));
+            const ParticleModel base = load_model(find_model(a->models.front()), data_dir());
+            if (a->apply && a->output.empty())
+              throw InputError("", "--output", "--apply needs -o NEW_MODEL.toml");
+            if (!a->output.empty()) check_writable(a->output, "--output");
+            if (!a->report.empty()) {
+              std::error_code ec;
+              std::filesystem::create_directories(a->report, ec);
+            }
+            check_outputs(*a);
+            DiagnoseOptions o;
+            o.scale = a->scale;
+            o.repeats = a->repeats;
+            o.seed = a->seed;
+            o.suggest = !a->no_suggest;
+            std::string list = a->effects;
+            for (size_t p; (p = list.find(',')) != std::string::npos; list.erase(0, p + 1))
+              if (p > 0) o.effects.push_back(list.substr(0, p));
+            if (!list.empty()) o.effects.push_back(list);
+            effect_candidates(base, o.effects, nullptr, "--effects");  // names checked up front
+            if (!a->quiet) o.progress = [](const std::string& s) { std::cerr << "diagnose: " << s << "\n"; };
+            RigSimulator sim = make_sim(*a);
+            const Diagnosis d = diagnose(base, ms, sim, o);
+            std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9} {:>9} {:>9} {:>7} {}\n",
+                                     "effect", "parameter", "fitted", "+/-", "chi2", "dchi2",
+                                     "BIC", "weight", "plausible");
+            std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9.2f} {:>9} {:>9.2f}\n",
+                                     "(baseline)", base.name, "", "", d.baseline.chi2, "",
+                                     d.baseline_bic);
+            for (const auto& r : d.candidates)
+              std::cout << fmt::format(
+                  "{:<18} {:<38} {:>14} {:>10.3g} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {}\n",
+                  r.candidate.effect, r.candidate.parameter, r.candidate.format(r.fitted),
+                  r.fitted_std, r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
+                  r.plausible ? "yes" : "no (at bound)");
+            for (const auto& s : d.skipped) std::cout << "not tried: " << s << "\n";
+            std::cout << d.summary();
+            std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n",
+                                     sim.runs(), sim.cache_hits());
+            json cands = json::array();
+            for (const auto& r : d.candidates)
+              cands.push_back({{"effect", r.candidate.effect},
+                               {"parameter", r.candidate.parameter},
+                               {"unit", r.candidate.unit},
+                               {"fitted", {{"value", r.fitted}, {"std", r.fitted_std}}},
+                               {"range", {r.candidate.lo, r.candidate.hi}},
+                               {"chi2", r.comparison.chi2},
+                               {"chi2_per_dof", r.comparison.chi2_per_dof},
+                               {"delta_chi2", r.delta_chi2},
+                               {"bic", r.bic},
+                               {"weight", r.weight},
+                               {"plausible", r.plausible},
+                               {"at_bound", r.at_bound}});
+            json sugg = json::array();
+            for (const auto& s : d.suggestions)
+              sugg.push_back({{"rig", s.rig}, {"sample", s.sample}, {"setting", s.setting},
+                              {"quantity", s.quantity}, {"separation_sigma", s.separation},
+                              {"between", s.between}});
+            json out = {{"baseline", comparison_json(d.baseline)},
+                        {"baseline_bic", d.baseline_bic},
+                        {"baseline_p", d.baseline_p},
+                        {"candidates", cands},
+                        {"verdict",
+                         {{"effect", d.consistent ? json(nullptr) : json(d.verdict)},
+                          {"consistent", d.consistent},
+                          {"confidence", d.confidence}}},
+                        {"drivers", d.drivers},
+                        {"indistinguishable", d.indistinguishable},
+                        {"suggestions", sugg},
+                        {"skipped", d.skipped},
+                        {"simulations", d.simulations},
+                        {"summary", d.summary()}};
+            ReportInput rep;
+            rep.chain.emplace_back(base.name, d.baseline);
+            if (a->apply) {
+              if (d.consistent) {
+                std::cout << "--apply: nothing to add, the model is consistent with the data\n";
+              } else {
+                const CandidateResult& top = d.candidates.front();
+                ParticleModel next = top.candidate.apply(base, top.fitted);
+                next.name = base.name + "+" + top.candidate.effect;
+                write_file_atomic(a->output,
+                                  format_model(next, a->output,
+                                               fmt::format("{} with {} = {} added by clumpkit "
+                                                           "diagnose",
+                                                           base.name, top.candidate.parameter,
+                                                           top.candidate.format(top.fitted))));
+                out["applied"] = {{"effect", top.candidate.effect}, {"model", a->output}};
+                rep.chain.emplace_back(next.name, top.comparison);
+                std::cout << "wrote " << a->output << " (" << next.name << ")\n";
+              }
+            }
+            if (!a->json.empty()) write_json(out, a->json);
+            if (!a->report.empty()) {
+              rep.title = "clumpkit diagnose: " + base.name;
+              rep.diagnosis = &d;
+              rep.pictures = sim.pictures();
+              write_report(rep, a->report);
+              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string() << "\n";
+            }
+            return 0;
+          }};
+}
+
+Command setup_synth(CLI::App& parent) {
+  auto a = std::make_shared<CalArgs>();
+  std::string templ;
+  CLI::App* c = parent.add_subcommand(
+      "synth", "Synthetic measurements from a truth model with realistic noise, to check the "
+               "compare/diagnose loop end to end");
+  c->add_option("--model", a->models, "Truth model file or bundled name")->required()->expected(1);
+  c->add_option("--measurements-template", a->measurements,
+                "CSV whose rows (rig, sample, setting, quantity, n, unit) are synthesised")
+      ->required();
+  c->add_option("--noise", a->noise, "Relative standard deviation of one lab repeat")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
+  c->add_option("-o,--output", a->output, "Output CSV")->required();
+  common_options(c, *a);
+  return {c, [a] {
+            auto ms = load_measurements(a->measurements);
+            const ParticleModel truth = load_model(find_model(a->models.front()), data_dir());
+            check_writable(a->output, "--output");
+            RigSimulator sim = make_sim(*a);
+            // The truth is simulated with seeds the diagnosis will not use by default.
+            const std::uint64_t seed = a->seed + 1000003;
+            const auto s = simulate_measurements(sim, truth, ms, a->scale, a->repeats, seed);
+            std::mt19937_64 rng(a->seed);
+            for (auto& m : ms) {
+              const double v = s.at(m.key()).mean;
+              m.std = a->noise * std::abs(v);
+              if (m.std <= 0) m.std = a->noise;
+              std::normal_distribution<double> g(0.0, m.std / std::sqrt(static_cast<double>(m.n)));
+              m.value = v + g(rng);
+              if (m.value < 0 && m.unit != "deg") m.value = 0.0;
+            }
+            write_file_atomic(a->output,
+                              fmt::format("# synthetic: truth model {}, noise {} relative, seed {}, "
+                                          "scale {}\n",
+                                          truth.name, a->noise, a->seed, a->scale) +
+                                  format_measurements(ms));
+            std::cout << fmt::format("wrote {} measurements to {}\n", ms.size(), a->output);
+            return 0;
+          }};
+}
+
+const Registration reg_compare(60, setup_compare);
+const Registration reg_diagnose(61, setup_diagnose);
+const Registration reg_synth(62, setup_synth);
+
+}  // namespace
+}  // namespace clumpkit::cli
+#endif
