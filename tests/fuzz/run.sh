@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Fuzzes every target of a CLUMPKIT_FUZZ=ON build, one after the other, each for a time budget,
+# starting from the committed seed corpus (which is never modified: new inputs go to a scratch
+# folder). Prints one line per target (executions, crashes) and exits 1 if any target crashed,
+# leaked, timed out or ran out of memory; the offending input is kept in <build>/fuzz-artifacts/.
+#   bash tests/fuzz/run.sh BUILD SECONDS_PER_TARGET [TARGET...]
+# e.g. the local long run (docs/hardening.md):  bash tests/fuzz/run.sh build-fuzz 1200
+set -uo pipefail
+build="${1:?usage: run.sh BUILD SECONDS_PER_TARGET [TARGET...]}"
+seconds="${2:?usage: run.sh BUILD SECONDS_PER_TARGET [TARGET...]}"
+shift 2
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+if [ "$#" -gt 0 ]; then targets=("$@"); else mapfile -t targets < "$build/tests/fuzz/targets.txt"; fi
+artifacts="$build/fuzz-artifacts"
+mkdir -p "$artifacts"
+scratch="$(mktemp -d)"
+trap 'rm -rf "$scratch"' EXIT
+dict_for() {
+  case "$1" in
+    units) echo "$here/dict/units.dict" ;;
+    *_json) echo "$here/dict/json.dict" ;;
+    *_file) echo "$here/dict/toml.dict" ;;
+    *) echo "" ;;
+  esac
+}
+failed=0
+for t in "${targets[@]}"; do
+  bin="$build/tests/fuzz/fuzz_$t"
+  [ -x "$bin" ] || { echo "fuzz $t: missing $bin" >&2; failed=1; continue; }
+  mkdir -p "$scratch/$t"
+  args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=8192
+        -print_final_stats=1 -artifact_prefix="$artifacts/$t-")
+  dict="$(dict_for "$t")"
+  [ -n "$dict" ] && [ -f "$dict" ] && args+=(-dict="$dict")
+  log="$artifacts/$t.log"
+  start=$(date +%s)
+  "$bin" "${args[@]}" "$scratch/$t" "$here/corpus/$t" "$here/regressions/$t" >"$log" 2>&1
+  rc=$?
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+  status=ok
+  if [ "$rc" -ne 0 ]; then
+    status="FAILED (exit $rc, see $log)"
+    grep -E 'ERROR|invariant|what\(\)|SUMMARY' "$log" | head -5 >&2
+    failed=1
+  fi
+  echo "fuzz $t: ${runs:-?} executions in $(( $(date +%s) - start )) s, $status"
+done
+exit "$failed"
