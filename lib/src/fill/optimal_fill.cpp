@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <queue>
 
@@ -145,7 +146,7 @@ class Optimiser {
     };
     std::priority_queue<Item> pq;
     for (std::int64_t c = 0; c < static_cast<std::int64_t>(cand_.size()); ++c) {
-      const double rho = (ctx_.tolerance - g.sdf[cand_[c]]) / g.h;
+      const double rho = std::min(ctx_.tolerance - g.sdf[cand_[c]], cap_) / g.h;
       pq.push({4.0 / 3.0 * kPi * rho * rho * rho + 8.0, -1, c});
     }
     int added = 0;
@@ -163,14 +164,14 @@ class Optimiser {
                         static_cast<double>(v % g.n.x()),
                         static_cast<double>((v / g.n.x()) % g.n.y()),
                         static_cast<double>(v / (static_cast<std::int64_t>(g.n.x()) * g.n.y())));
-          s.radius = ctx_.max_radius(s.center);
+          s.radius = std::min(ctx_.max_radius(s.center), cap_);
           if (s.radius < std::max(o_.min_radius, 1e-6 * ctx_.size)) continue;  // drop candidate
           spheres.push_back(s);
           mark(covered, s);
           ++added;
           break;
         }
-        const double rho = ctx_.tolerance - g.sdf[cand_[top.cand]];
+        const double rho = std::min(ctx_.tolerance - g.sdf[cand_[top.cand]], cap_);
         pq.push({gain(covered, cand_[top.cand], rho), round, top.cand});
       }
     }
@@ -277,7 +278,29 @@ class Optimiser {
 
   void budget_mode(Spheres& s) {
     const int n = o_.spheres;
-    seed(s, n);
+    // Multi-start: the plain coverage greedy opens with the largest sphere, which can trap the
+    // descent (a flat pill); starts whose radii are capped near the equal-volume radius of n
+    // spheres spread the spheres out. The best start after a short descent goes on.
+    const double r_eq = std::cbrt(3.0 * ctx_.cache->shape_volume() / (4.0 * kPi * n));
+    double best_f = std::numeric_limits<double>::infinity();
+    Spheres best;
+    for (const double cap : {std::numeric_limits<double>::infinity(), 1.25 * r_eq, r_eq}) {
+      cap_ = cap;
+      step_ = 0.01 * ctx_.size;
+      Spheres t;
+      seed(t, n);
+      const double ft = refine(t, 15);
+      history_.push_back({{"stage", "start"},
+                          {"radius_cap", std::isinf(cap) ? -1.0 : cap},
+                          {"spheres", t.size()},
+                          {"objective", ft}});
+      if (ft < best_f) {
+        best_f = ft;
+        best = std::move(t);
+      }
+    }
+    cap_ = std::numeric_limits<double>::infinity();
+    s = std::move(best);
     double f = refine(s, 40);
     history_.push_back({{"stage", "seed+refine"}, {"spheres", s.size()}, {"objective", f}});
     const int rounds = std::clamp(120 / std::max(1, n), 2, 8);
@@ -340,6 +363,7 @@ class Optimiser {
   std::vector<std::int64_t> cand_;
   int threads_ = 1;
   double step_ = 0.0;
+  double cap_ = std::numeric_limits<double>::infinity();  // radius cap of seeded spheres, m
   std::int64_t evaluations_ = 0, iterations_ = 0;
   nlohmann::json history_ = nlohmann::json::array();
 };
