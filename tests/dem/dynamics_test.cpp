@@ -85,6 +85,8 @@ TEST(Dynamics, RollingSphereDeceleratesAsPaperEq2) {
   const double expected = 5.0 / 7.0 * mu_r * g;
   EXPECT_NEAR(rolling_deceleration(RollingModel::kStandard, mu_r), expected, 0.02 * expected);
   EXPECT_NEAR(rolling_deceleration(RollingModel::kCdt, mu_r), expected, 0.02 * expected);
+  // For a single sphere the contact lies one radius from the centre of mass.
+  EXPECT_NEAR(rolling_deceleration(RollingModel::kStandardCom, mu_r), expected, 0.02 * expected);
   EXPECT_NEAR(rolling_deceleration(RollingModel::kEpsd, mu_r), expected, 0.05 * expected);
 }
 

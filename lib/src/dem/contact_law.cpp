@@ -16,6 +16,8 @@ const char* to_string(RollingModel m) {
   switch (m) {
     case RollingModel::kStandard:
       return "standard";
+    case RollingModel::kStandardCom:
+      return "standard_com";
     case RollingModel::kCdt:
       return "cdt";
     case RollingModel::kEpsd:
@@ -27,9 +29,11 @@ const char* to_string(RollingModel m) {
 RollingModel rolling_model_from_string(const std::string& s, const std::string& where,
                                        const std::string& field) {
   if (s == "standard") return RollingModel::kStandard;
+  if (s == "standard_com") return RollingModel::kStandardCom;
   if (s == "cdt") return RollingModel::kCdt;
   if (s == "epsd") return RollingModel::kEpsd;
-  throw InputError(where, field, "unknown rolling model '" + s + "' (known: standard, cdt, epsd)");
+  throw InputError(where, field,
+                   "unknown rolling model '" + s + "' (known: standard, standard_com, cdt, epsd)");
 }
 
 PairContact PairContact::from(const Interaction& i, RollingModel model) {
@@ -154,6 +158,12 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
       const double mag = mu_r * std::abs(fn_contact);
       out.roll_i = mag * k.radius_i;
       out.roll_j = mag * k.radius_j;  // 0 against a wall
+      break;
+    }
+    case RollingModel::kStandardCom: {
+      const double mag = mu_r * std::abs(fn_contact);
+      out.roll_i = mag * k.arm_i;
+      out.roll_j = mag * k.arm_j;
       break;
     }
     case RollingModel::kCdt: {

@@ -348,6 +348,8 @@ void World::Impl::compute_forces(double hdt) {
     kin.m_star = ti.mass * tj.mass / (ti.mass + tj.mass);
     kin.radius_i = s_r[p.i];
     kin.radius_j = s_r[p.j];
+    kin.arm_i = (pc.point - c_x[ci]).norm();
+    kin.arm_j = (pc.point - c_x[cj]).norm();
     kin.omega_i = c_ww[ci];
     kin.omega_j = c_ww[cj];
     kin.v_rel = (c_v[ci] + c_ww[ci].cross(pc.point - c_x[ci])) -
@@ -374,6 +376,8 @@ void World::Impl::compute_forces(double hdt) {
       kin.m_star = t.mass;
       kin.radius_i = s_r[s];
       kin.radius_j = 0.0;
+      kin.arm_i = (wc.point - c_x[c]).norm();
+      kin.arm_j = 0.0;
       kin.omega_i = c_ww[c];
       kin.omega_j = wd.state.pose.omega;
       const Eigen::Vector3d vw = wd.state.pose.velocity_at(wc.point);

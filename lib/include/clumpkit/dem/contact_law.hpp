@@ -21,10 +21,14 @@ enum class RollingModel {
   /// Elastic–plastic spring–dashpot, "type C" (Ai et al. 2011): rolling spring
   /// k_r = 2.25 S_n μr² R*², torque capped at μr R* |Fn|, viscous damping off at the cap.
   kEpsd,
+  /// (Last, so the earlier values keep their numbers.) EDEM's help text variant of the standard
+  /// model: R = distance from the contact point to the
+  /// clump's centre of mass (larger than the sub-sphere radius for off-centre spheres).
+  kStandardCom,
 };
 
 const char* to_string(RollingModel m);
-/// "standard", "cdt" or "epsd"; throws InputError(where, field) otherwise.
+/// "standard", "standard_com", "cdt" or "epsd"; throws InputError(where, field) otherwise.
 RollingModel rolling_model_from_string(const std::string& s, const std::string& where = "",
                                        const std::string& field = "");
 
@@ -79,7 +83,9 @@ struct ContactKinematics {
   double m_star = 0.0;     ///< kg
   double radius_i = 0.0;   ///< sub-sphere radius of i (standard rolling), m
   double radius_j = 0.0;   ///< of j, 0 for a wall
-  Eigen::Vector3d v_rel;   ///< velocity of i minus velocity of j at the contact point, m/s
+  double arm_i = 0.0;  ///< distance contact point – centre of mass of clump i (standard_com), m
+  double arm_j = 0.0;  ///< of clump j, 0 for a wall
+  Eigen::Vector3d v_rel;  ///< velocity of i minus velocity of j at the contact point, m/s
   /// The same relative velocity at the time of the positions, for the damping terms only (the
   /// World passes velocity Verlet's predicted v(t); v_rel is the half-step velocity, which moves
   /// the springs consistently with the positions). Absent = v_rel.
