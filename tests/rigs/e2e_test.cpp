@@ -26,8 +26,18 @@ RigRequest request(const std::string& rig, const std::string& settings, const st
   return r;
 }
 
+// Smaller than mini, to keep the suite short: ~100-200 pills per rig.
+void tiny(ScaleParams& p) {
+  p.cup_diameter = 0.030, p.cup_height = 0.029;
+  p.heap_mass = 0.03, p.tube_diameter = 0.036, p.tube_height = 0.09, p.lift_speed = 0.05;
+  p.settle_max = 0.5;
+  p.wheel_scale = 0.4, p.bed_mass = 0.025;
+}
+
 TEST(RigEndToEnd, BulkDensityOfTheProductionMix) {
-  const RigResult r = run_rig(request("bulk_density", "scale=mini", "e2e_bulk"));
+  RigRequest q = request("bulk_density", "scale=mini", "e2e_bulk");
+  q.adjust = tiny;
+  const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
   ASSERT_EQ(r.repeats.size(), 1u);
   const double rho = r.stats.at("bulk_density").mean;
@@ -40,7 +50,9 @@ TEST(RigEndToEnd, BulkDensityOfTheProductionMix) {
 }
 
 TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
-  const RigResult r = run_rig(request("angle_of_repose", "scale=mini", "e2e_aor"));
+  RigRequest q = request("angle_of_repose", "scale=mini", "e2e_aor");
+  q.adjust = tiny;
+  const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
   const double deg = 180.0 / std::numbers::pi;
   const double a = r.stats.at("angle").mean * deg;
@@ -52,6 +64,7 @@ TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
   // A rerun keeps the finished repeat instead of simulating again.
   RigRequest again = request("angle_of_repose", "scale=mini", "e2e_aor_again");
   again.out = dir.parent_path();
+  again.adjust = tiny;
   const RigResult r2 = run_rig(again);
   ASSERT_EQ(r2.repeats.size(), 1u);
   EXPECT_TRUE(r2.repeats[0].resumed);
@@ -59,7 +72,9 @@ TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
 }
 
 TEST(RigEndToEnd, DischargeFillsThePockets) {
-  const RigResult r = run_rig(request("discharge", "scale=mini;rpm=30;pockets=2", "e2e_discharge"));
+  RigRequest q = request("discharge", "scale=mini;rpm=30;pockets=2", "e2e_discharge");
+  q.adjust = tiny;
+  const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
   const double m = r.stats.at("pocket_mass").mean;
   EXPECT_GT(m, 0.0);

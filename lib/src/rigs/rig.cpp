@@ -380,10 +380,10 @@ RepeatResult bulk_density(Ctx& c) {
   for (const auto& t : c.types)
     for (const auto& sp : t.clump.spheres) r_min = std::min(r_min, sp.radius);
   auto scraper = [&](double t_on) {
-    // The blade clears the rim by a fifth of the smallest sphere radius, so a pill half below
-    // the rim is rolled away rather than wedged between blade and bed.
+    // The blade clears the rim by the smallest sphere radius, so a pill straddling the rim is
+    // rolled away rather than wedged between the blade and the rim (a blow-up otherwise).
     dem::WallSettings s{
-        "scraper", scraper_mesh(x_start, R + 0.02, H + 0.2 * r_min, 0.06), cup_material, {}, {}};
+        "scraper", scraper_mesh(x_start, R + 0.02, H + r_min, 0.06), cup_material, {}, {}};
     s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / p.scraper_speed,
                                          Vector3d(p.scraper_speed, 0, 0));
     return s;
@@ -745,6 +745,7 @@ RigResult run_rig(const RigRequest& req) {
   res.model = req.model.name;
   res.settings = req.settings;
   res.params = rig_scale(req.rig, req.settings);
+  if (req.adjust) req.adjust(res.params);
   res.scale = res.params.name;
   Ctx proto{req, res.params, {}, {}, 1, 0};
   if (req.progress) req.progress("building clump templates: " + req.model.summary());

@@ -63,6 +63,9 @@ struct RigRequest {
   long rays = 20000;                  ///< ray sampling of the clumps' mass properties
   double checkpoint_interval = 60.0;  ///< s of wall-clock time between checkpoints
   std::function<void(const std::string&)> progress;  ///< one line per call, may be empty
+  /// Edits the scale's parameters after the settings are applied (tests and studies that need
+  /// a rig smaller than `mini`); recorded in the result like any other parameter.
+  std::function<void(ScaleParams&)> adjust;
 };
 
 struct RepeatResult {
