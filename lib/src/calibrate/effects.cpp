@@ -57,76 +57,36 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
   const ModelEffects& fx = base.effects;
   std::vector<EffectCandidate> out;
 
-  if (wanted("rolling_friction")) {
+  // A continuous effect: one parameter set through a model-file key (`unit` appended to values).
+  auto continuous = [&](const std::string& effect, const std::string& parameter,
+                        const std::string& unit, double lo, double hi, double baseline,
+                        double step) {
+    if (!wanted(effect)) return;
     EffectCandidate c;
-    c.effect = "rolling_friction";
-    c.parameter = "mu_r, pill-pill and pill-wall";
-    c.unit = "1";
-    c.lo = 0.0;
-    c.hi = 0.5;
-    c.baseline = first_value(fx.rolling_friction, "pill", 0.0);
-    c.probe = probe_from(c.baseline, 0.08, c.lo, c.hi);
-    c.apply = [](const ParticleModel& m, double v) {
-      return with(m, "effects.rolling_friction", fmt::format("{:.17g}", v));
+    c.effect = effect;
+    c.parameter = parameter;
+    c.unit = unit;
+    c.lo = lo;
+    c.hi = hi;
+    c.baseline = baseline;
+    c.probe = probe_from(baseline, step, lo, hi);
+    const std::string key = "effects." + effect;
+    const std::string suffix = unit == "1" ? "" : " " + unit;
+    c.apply = [key, suffix](const ParticleModel& m, double v) {
+      return with(m, key, fmt::format("{:.17g}{}", v, suffix));
     };
     out.push_back(c);
-  }
-  if (wanted("particle_friction")) {
-    EffectCandidate c;
-    c.effect = "particle_friction";
-    c.parameter = "mu_s, pill-pill";
-    c.unit = "1";
-    c.lo = 0.0;
-    c.hi = 1.2;
-    c.baseline = fx.particle_friction.value_or(0.0);
-    c.probe = probe_from(c.baseline, 0.25, c.lo, c.hi);
-    c.apply = [](const ParticleModel& m, double v) {
-      return with(m, "effects.particle_friction", fmt::format("{:.17g}", v));
-    };
-    out.push_back(c);
-  }
-  if (wanted("wall_friction")) {
-    EffectCandidate c;
-    c.effect = "wall_friction";
-    c.parameter = "mu_s, pill-wall (all wall materials)";
-    c.unit = "1";
-    c.lo = 0.0;
-    c.hi = 1.2;
-    c.baseline = first_value(fx.wall_friction, "galvanized_steel", 0.0);
-    c.probe = probe_from(c.baseline, 0.25, c.lo, c.hi);
-    c.apply = [](const ParticleModel& m, double v) {
-      return with(m, "effects.wall_friction", fmt::format("{:.17g}", v));
-    };
-    out.push_back(c);
-  }
-  if (wanted("restitution")) {
-    EffectCandidate c;
-    c.effect = "restitution";
-    c.parameter = "e, all pairs";
-    c.unit = "1";
-    c.lo = 0.05;
-    c.hi = 1.0;
-    c.baseline = first_value(fx.restitution, "pill", 1.0);
-    c.probe = probe_from(c.baseline, 0.3, c.lo, c.hi);
-    c.apply = [](const ParticleModel& m, double v) {
-      return with(m, "effects.restitution", fmt::format("{:.17g}", v));
-    };
-    out.push_back(c);
-  }
-  if (wanted("cohesion")) {
-    EffectCandidate c;
-    c.effect = "cohesion";
-    c.parameter = "SJKR energy density, pill-pill";
-    c.unit = "J/m^3";
-    c.lo = 0.0;
-    c.hi = 5e4;
-    c.baseline = fx.cohesion.value_or(0.0);
-    c.probe = probe_from(c.baseline, 8e3, c.lo, c.hi);
-    c.apply = [](const ParticleModel& m, double v) {
-      return with(m, "effects.cohesion", fmt::format("{:.17g} J/m^3", v));
-    };
-    out.push_back(c);
-  }
+  };
+  continuous("rolling_friction", "mu_r, pill-pill and pill-wall", "1", 0.0, 0.5,
+             first_value(fx.rolling_friction, "pill", 0.0), 0.08);
+  continuous("particle_friction", "mu_s, pill-pill", "1", 0.0, 1.2,
+             fx.particle_friction.value_or(0.0), 0.25);
+  continuous("wall_friction", "mu_s, pill-wall (all wall materials)", "1", 0.0, 1.2,
+             first_value(fx.wall_friction, "galvanized_steel", 0.0), 0.25);
+  continuous("restitution", "e, all pairs", "1", 0.05, 1.0,
+             first_value(fx.restitution, "pill", 1.0), 0.3);
+  continuous("cohesion", "SJKR energy density, pill-pill", "J/m^3", 0.0, 5e4,
+             fx.cohesion.value_or(0.0), 8e3);
   if (wanted("shape_resolution")) {
     // Sphere counts every paper-rule type of the model has a preset for.
     std::set<int> common;
