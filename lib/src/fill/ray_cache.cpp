@@ -46,6 +46,7 @@ RayCache::RayCache(const RaySolid& shape, const Eigen::AlignedBox3d& box, std::i
                    std::uint64_t seed, int threads) {
   const double per_axis = static_cast<double>(std::max<std::int64_t>(rays, 300)) / 3.0;
   const int nt = threads > 0 ? threads : omp_get_max_threads();
+  threads_ = std::max(1, nt);
   for (int axis = 0; axis < 3; ++axis) {
     Axis& A = axes_[axis];
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
@@ -97,23 +98,31 @@ RayCache::RayCache(const RaySolid& shape, const Eigen::AlignedBox3d& box, std::i
 
 RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
                                   std::vector<double>* removal_cost) const {
-  Eval e;
-  std::vector<int> count, start;
   struct Chord {
     double t0, t1;
     int id;
   };
-  std::vector<Chord> items;
   // Sweep events along one line: position, kind (0 shape toggle, 1 sphere start, 2 sphere end).
   struct Event {
     double t;
     int kind, id;
   };
-  std::vector<Event> ev;
-  IntervalList uni;
-  std::vector<double> cost;
-  if (removal_cost) cost.assign(spheres.size(), 0.0);
+  // The three axes are independent estimates: computed in parallel into their own slots and
+  // summed in a fixed order, so the result is bit-identical whatever the thread count.
+  struct AxisOut {
+    double xor_volume = 0.0, union_volume = 0.0;
+    Moments m;
+    std::vector<double> cost;
+  };
+  AxisOut outs[3];
+#pragma omp parallel for num_threads(std::min(threads_, 3)) schedule(static, 1)
   for (int axis = 0; axis < 3; ++axis) {
+    std::vector<int> count, start;
+    std::vector<Chord> items;
+    std::vector<Event> ev;
+    IntervalList uni;
+    std::vector<double>& cost = outs[axis].cost;
+    if (removal_cost) cost.assign(spheres.size(), 0.0);
     const Axis& A = axes_[axis];
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
     const int lines = A.nu * A.nv;
@@ -195,21 +204,24 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
       uni_len += lu;
       if (moments) accumulate_moments(uni, axis, A.pu[l], A.pv[l], area, m);
     }
-    e.xor_volume += xor_len * area / 3.0;
-    e.union_volume += uni_len * area / 3.0;
-    if (removal_cost)
-      for (double& c : cost) c *= area / 3.0;  // scale this axis' share, then keep summing
-    if (removal_cost) {
-      if (axis == 0) removal_cost->assign(spheres.size(), 0.0);
-      for (size_t k = 0; k < cost.size(); ++k) (*removal_cost)[k] += cost[k];
-      std::fill(cost.begin(), cost.end(), 0.0);
-    }
+    outs[axis].xor_volume = xor_len * area / 3.0;
+    outs[axis].union_volume = uni_len * area / 3.0;
+    for (double& c : cost) c *= area / 3.0;
     if (moments) {
       m.m0 /= 3.0;
       m.m1 /= 3.0;
       m.m2 /= 3.0;
-      e.union_moments += m;
+      outs[axis].m = m;
     }
+  }
+  Eval e;
+  if (removal_cost) removal_cost->assign(spheres.size(), 0.0);
+  for (const AxisOut& o : outs) {
+    e.xor_volume += o.xor_volume;
+    e.union_volume += o.union_volume;
+    if (moments) e.union_moments += o.m;
+    if (removal_cost)
+      for (size_t k = 0; k < spheres.size(); ++k) (*removal_cost)[k] += o.cost[k];
   }
   return e;
 }

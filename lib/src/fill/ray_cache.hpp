@@ -45,6 +45,7 @@ class RayCache {
   Axis axes_[3];
   double shape_volume_ = 0.0;
   Moments shape_moments_;
+  int threads_ = 1;
 };
 
 /// Moments of a normalised interval list along one line (as integrate_rays accumulates them).
