@@ -376,14 +376,15 @@ RepeatResult bulk_density(Ctx& c) {
       pour(c, dem::CylinderRegion{Vector3d(0, 0, H + 0.005), fr, fh}, pour_mass));
   // The scraper waits beside the cup; phase 2 moves it across the rim.
   const double x_start = -(R + 0.012), x_end = R + 0.02;
-  double r_min = 1.0;
+  double r_max = 0.0;
   for (const auto& t : c.types)
-    for (const auto& sp : t.clump.spheres) r_min = std::min(r_min, sp.radius);
+    for (const auto& sp : t.clump.spheres) r_max = std::max(r_max, sp.radius);
   auto scraper = [&](double t_on) {
-    // The blade clears the rim by the smallest sphere radius, so a pill straddling the rim is
-    // rolled away rather than wedged between the blade and the rim (a blow-up otherwise).
+    // The blade clears the rim by the largest sphere diameter, so no sphere can touch blade and
+    // rim at once (lower blades wedged pills against the rim: the engine reported a blow-up).
+    // Pills are weighed by their centre, so what the blade leaves above the rim is not counted.
     dem::WallSettings s{
-        "scraper", scraper_mesh(x_start, R + 0.02, H + r_min, 0.06), cup_material, {}, {}};
+        "scraper", scraper_mesh(x_start, R + 0.02, H + 2.0 * r_max, 0.06), cup_material, {}, {}};
     s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / p.scraper_speed,
                                          Vector3d(p.scraper_speed, 0, 0));
     return s;
