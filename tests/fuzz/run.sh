@@ -34,7 +34,10 @@ for t in "${targets[@]}"; do
   [ -n "$dict" ] && [ -f "$dict" ] && args+=(-dict="$dict")
   log="$artifacts/$t.log"
   start=$(date +%s)
-  "$bin" "${args[@]}" "$scratch/$t" "$here/corpus/$t" "$here/regressions/$t" >"$log" 2>&1
+  # Corpus folders that exist (git does not keep an empty regressions/<target>/).
+  dirs=("$scratch/$t")
+  for d in "$here/corpus/$t" "$here/regressions/$t"; do [ -d "$d" ] && dirs+=("$d"); done
+  "$bin" "${args[@]}" "${dirs[@]}" >"$log" 2>&1
   rc=$?
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
   status=ok
