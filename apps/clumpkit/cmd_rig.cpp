@@ -27,20 +27,6 @@ struct RigArgs {
   long rays = 20000;
 };
 
-fs::path resolve_model(const std::string& arg) {
-  std::error_code ec;
-  if (fs::exists(arg, ec) && fs::is_regular_file(arg, ec)) return arg;
-  for (const fs::path& cand :
-       {data_dir() / "shapes" / "models" / (arg + ".toml"), data_dir() / "shapes" / "models" / arg})
-    if (fs::exists(cand, ec)) return cand;
-  std::string known;
-  for (const auto& e : fs::directory_iterator(data_dir() / "shapes" / "models", ec))
-    if (e.path().extension() == ".toml")
-      known += (known.empty() ? "" : ", ") + e.path().stem().string();
-  throw InputError("--model", "",
-                   "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
-}
-
 void list_rigs() {
   for (const auto& r : rig_catalogue()) {
     std::cout << fmt::format("{}: {}\n  quantities:", r.name, r.description);
@@ -103,7 +89,7 @@ Command setup(CLI::App& parent) {
             const RigInfo& info = find_rig(a->rig, "", "rig");
             rigs::RigRequest req;
             req.rig = info.name;
-            req.model = load_model(resolve_model(a->model), data_dir());
+            req.model = load_model(find_model(a->model), data_dir());
             std::string settings = a->scale.empty() ? "" : "scale=" + a->scale;
             for (const auto& s : a->sets) {
               const auto eq = s.find('=');

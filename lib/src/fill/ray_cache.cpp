@@ -19,29 +19,6 @@ double to_unit(std::uint64_t x) {
 }
 }  // namespace
 
-void accumulate_moments(const IntervalList& list, int axis, double pu, double pv, double area,
-                        Moments& m) {
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  for (const Interval& iv : list) {
-    const double a = iv.t0, b = iv.t1, l = b - a;
-    const double s1 = 0.5 * (b * b - a * a), s2 = (b * b * b - a * a * a) / 3.0;
-    m.m0 += area * l;
-    m.m1[axis] += area * s1;
-    m.m1[u] += area * pu * l;
-    m.m1[v] += area * pv * l;
-    m.m2(axis, axis) += area * s2;
-    m.m2(u, u) += area * pu * pu * l;
-    m.m2(v, v) += area * pv * pv * l;
-    const double au = area * pu * s1, av = area * pv * s1, uv = area * pu * pv * l;
-    m.m2(axis, u) += au;
-    m.m2(u, axis) += au;
-    m.m2(axis, v) += av;
-    m.m2(v, axis) += av;
-    m.m2(u, v) += uv;
-    m.m2(v, u) += uv;
-  }
-}
-
 RayCache::RayCache(const RaySolid& shape, const Eigen::AlignedBox3d& box, std::int64_t rays,
                    std::uint64_t seed, int threads) {
   const double per_axis = static_cast<double>(std::max<std::int64_t>(rays, 300)) / 3.0;

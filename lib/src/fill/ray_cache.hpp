@@ -48,8 +48,4 @@ class RayCache {
   int threads_ = 1;
 };
 
-/// Moments of a normalised interval list along one line (as integrate_rays accumulates them).
-void accumulate_moments(const IntervalList& list, int axis, double pu, double pv, double area,
-                        Moments& m);
-
 }  // namespace clumpkit::detail

@@ -55,8 +55,11 @@ struct RowRng {
   }
 };
 
-void accumulate(const IntervalList& list, int axis, int u, int v, double pu, double pv,
-                double area, Moments& m) {
+}  // namespace
+
+void accumulate_moments(const IntervalList& list, int axis, double pu, double pv, double area,
+                        Moments& m) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   for (const Interval& iv : list) {
     const double a = iv.t0, b = iv.t1;
     const double l = b - a;
@@ -78,7 +81,6 @@ void accumulate(const IntervalList& list, int axis, int u, int v, double pu, dou
     m.m2(v, u) += uv;
   }
 }
-}  // namespace
 
 std::vector<std::vector<Moments>> integrate_rays(const Eigen::AlignedBox3d& box_in, int nchannels,
                                                  const RayChannels& channels,
@@ -120,7 +122,7 @@ std::vector<std::vector<Moments>> integrate_rays(const Eigen::AlignedBox3d& box_
             origin[v] = pv;
             for (auto& c : ch) c.clear();
             channels(origin, axis, ch);
-            for (int c = 0; c < nchannels; ++c) accumulate(ch[c], axis, u, v, pu, pv, area, rows[i][c]);
+            for (int c = 0; c < nchannels; ++c) accumulate_moments(ch[c], axis, pu, pv, area, rows[i][c]);
           }
         }
       }

@@ -54,6 +54,11 @@ std::vector<std::vector<Moments>> integrate_rays(const Eigen::AlignedBox3d& box,
 /// Convenience: the moments of one solid, as replicate samples.
 std::vector<Moments> integrate_solid(const RaySolid& solid, const RaySamplingOptions& options);
 
+/// Adds the exact moments of the inside intervals of one line along `axis` through transverse
+/// coordinates (pu, pv) (u = axis+1, v = axis+2, mod 3), weighted by the cell `area`.
+void accumulate_moments(const IntervalList& list, int axis, double pu, double pv, double area,
+                        Moments& m);
+
 /// Mean over replicate samples.
 Moments mean_moments(const std::vector<Moments>& samples);
 
