@@ -211,15 +211,19 @@ TEST(FillTemplate, CentroidPrincipalFrameAndProvenance) {
 
 // ---- the command line -------------------------------------------------------------------------
 namespace {
+// ctest runs each test in its own process, several at once: each test keeps its own stderr file.
+std::string error_file() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  return std::string(CLUMPKIT_BINARY_DIR) + "/fill_cli_err_" + info->name() + ".txt";
+}
 int run(const std::string& args) {
   const std::string cmd = std::string(CLUMPKIT_BINARY_DIR) + "/apps/clumpkit/clumpkit " + args +
-                          " > /dev/null 2> " + std::string(CLUMPKIT_BINARY_DIR) +
-                          "/fill_cli_err.txt";
+                          " > /dev/null 2> " + error_file();
   const int rc = std::system(cmd.c_str());
   return WEXITSTATUS(rc);
 }
 std::string last_error() {
-  std::ifstream in(std::string(CLUMPKIT_BINARY_DIR) + "/fill_cli_err.txt");
+  std::ifstream in(error_file());
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 std::filesystem::path scratch(const std::string& name) {
