@@ -24,10 +24,11 @@ const std::vector<RigInfo>& rig_catalogue() {
   static const std::vector<RigInfo> rigs = [] {
     const double deg = std::numbers::pi / 180.0;
     const SettingInfo scale{"scale",
-                            {"mini", "small", "paper"},
+                            {"tiny", "mini", "small", "paper"},
                             "",
                             "mini",
-                            "rig size: mini (quick), small, paper (the paper's sizes)"};
+                            "rig size: tiny (smoke tests, ~100-200 pills), mini (quick), small, "
+                            "paper (the paper's sizes)"};
     const std::vector<std::string> walls = {"abs_plastic", "organic_glass", "galvanized_steel"};
     // A speed-up, not physics: every Young's modulus times this factor (the scale sets it).
     const SettingInfo stiffness{

@@ -30,7 +30,7 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
   ScaleParams p;
   const auto it = settings.find("scale");
   p.name = it == settings.end() ? "mini" : it->second;
-  if (p.name == "mini") {
+  if (p.name == "mini" || p.name == "tiny") {
     // Quick work: softer pills (a larger time step), a smaller cup, a smaller heap lifted
     // faster, a half-size wheel in a two-pill slice.
     p.stiffness_scale = 0.05;
@@ -48,6 +48,14 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
     p.slice_length = 0.012;
     p.bed_mass = 0.05;
     p.pockets_measured = 3;
+    if (p.name == "tiny") {
+      // Smoke tests and the calibration loop's end-to-end test: mini made smaller still
+      // (~100-200 pills per rig). Observables are noisier and further from paper scale.
+      p.cup_diameter = 0.030, p.cup_height = 0.029;
+      p.heap_mass = 0.03, p.tube_diameter = 0.036, p.tube_height = 0.09, p.lift_speed = 0.05;
+      p.settle_max = 0.5;
+      p.wheel_scale = 0.4, p.bed_mass = 0.025;
+    }
   } else if (p.name == "small") {
     p.stiffness_scale = 0.1;
     p.rayleigh_fraction = 0.25;

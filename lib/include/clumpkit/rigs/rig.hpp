@@ -23,7 +23,7 @@ namespace clumpkit::rigs {
 /// Numbers that size a rig at one scale. Defaults are filled by rig_scale(); every field is
 /// reported in the result's JSON so a run documents itself.
 struct ScaleParams {
-  std::string name;                ///< mini | small | paper
+  std::string name;                ///< tiny | mini | small | paper
   double stiffness_scale = 1.0;    ///< factor on every Young's modulus (speed-up, see docs)
   double rayleigh_fraction = 0.2;  ///< time step / Rayleigh time
   double settle_speed = 0.005;     ///< m/s, RMS clump speed below which a bed is at rest
