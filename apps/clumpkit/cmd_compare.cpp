@@ -30,8 +30,8 @@ struct CalArgs {
 };
 
 void common_options(CLI::App* c, CalArgs& a) {
-  c->add_option("--scale", a.scale, "Rig scale: mini | small | paper")
-      ->check(CLI::IsMember({"mini", "small", "paper"}))
+  c->add_option("--scale", a.scale, "Rig scale: tiny | mini | small | paper")
+      ->check(CLI::IsMember({"tiny", "mini", "small", "paper"}))
       ->capture_default_str();
   c->add_option("--repeats", a.repeats, "Simulation repeats (different seeds) per rig setting")
       ->check(CLI::Range(1, 100))
