@@ -11,7 +11,7 @@ namespace clumpkit::dem {
 
 namespace {
 
-constexpr char kMagic[] = "clumpkit-dem-checkpoint/1";
+constexpr char kMagic[] = "clumpkit-dem-checkpoint/2";  // 2: ContactHistory.damping
 
 struct Writer {
   std::string buf;

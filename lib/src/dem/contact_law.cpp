@@ -106,6 +106,19 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
                       ContactHistory& h, ContactForce& out) {
   const Eigen::Vector3d& n = k.normal;
   const double delta = k.overlap;
+  out.torque_i.setZero();
+  out.torque_j.setZero();
+  out.roll_i = out.roll_j = 0.0;
+  out.elastic_energy = 0.0;
+  if (!(delta > 0.0)) {
+    // Closing contact: the overlap ended during the step; only the damping impulse that
+    // belongs to the part of the window before the separation is left.
+    const double fn = dt > 0.0 ? -h.damping / dt : 0.0;
+    out.force = fn * n;
+    out.normal = fn;
+    if (dt > 0.0) h = ContactHistory{};
+    return;
+  }
   const double sqrt_rd = std::sqrt(k.r_star * delta);
   // Normal: Hertz spring plus the paper's damping, eq. (3).
   const double sn = 2.0 * law.e_star * sqrt_rd;
@@ -114,7 +127,21 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   const Eigen::Vector3d& vd = k.v_rel_damping ? *k.v_rel_damping : k.v_rel;
   const double vdn = vd.dot(n);
   double fn = f_hertz;
-  if (law.damping) fn -= kDampingFactor * law.beta * std::sqrt(sn * k.m_star) * vdn;
+  if (law.damping) {
+    // c δ^(1/4) δ̇ = dΦ/dt, Φ(δ) = (4/5) c δ^(5/4); δ̇ = −vdn.
+    const double c = kDampingFactor * law.beta * std::sqrt(2.0 * law.e_star * std::sqrt(k.r_star) *
+                                                           k.m_star);
+    if (dt > 0.0) {
+      const double d_up = delta - 0.5 * dt * vdn;
+      const double phi_up = d_up > 0.0 ? 0.8 * c * d_up * std::sqrt(std::sqrt(d_up)) : 0.0;
+      fn += (phi_up - h.damping) / dt;
+      h.damping = phi_up;
+    } else {
+      fn -= c * std::sqrt(std::sqrt(delta)) * vdn;
+    }
+  } else {
+    h.damping = 0.0;
+  }
   const double fn_contact = fn;  // Coulomb and rolling limits use the contact force
   out.elastic_energy = 0.4 * f_hertz * delta;
   if (law.cohesion) {
@@ -124,9 +151,6 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   }
   out.force = fn * n;
   out.normal = fn;
-  out.torque_i.setZero();
-  out.torque_j.setZero();
-  out.roll_i = out.roll_j = 0.0;
 
   // Tangential: Mindlin no-slip history spring with damping, capped at μs |Fn|, eq. (4).
   if (law.friction) {
@@ -167,11 +191,15 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
       break;
     }
     case RollingModel::kCdt: {
+      // As LIGGGHTS 3.8 rolling_model_cdt.h: the elastic (Hertz) normal force k_n δ, the
+      // direction of ω_rel = ω_i − ω_j, and the twisting (normal) part of the torque removed.
       const Eigen::Vector3d wr = k.omega_i - k.omega_j;
       const double wn = wr.norm();
       if (wn > 0.0) {
-        out.torque_i = -(mu_r * k.r_star * std::abs(fn_contact) / wn) * wr;
-        out.torque_j = -out.torque_i;
+        Eigen::Vector3d tq = (mu_r * k.r_star * f_hertz / wn) * wr;
+        tq -= tq.dot(n) * n;
+        out.torque_i = -tq;
+        out.torque_j = tq;
       }
       break;
     }

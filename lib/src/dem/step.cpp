@@ -191,6 +191,11 @@ void World::Impl::detect_contacts() {
     const double d2 = (s_pos[p.i] - s_pos[p.j]).squaredNorm();
     if (d2 < rr * rr) {
       dist[k] = std::sqrt(d2);
+    } else if (pair_hist[k].damping != 0.0) {
+      // Closing: the overlap ended during the step, one damping impulse is left.
+      dist[k] = -1.0 - std::sqrt(d2);
+      pair_hist[k].shear.setZero();
+      pair_hist[k].roll.setZero();
     } else {
       dist[k] = -1.0;
       pair_hist[k] = ContactHistory{};
@@ -199,14 +204,16 @@ void World::Impl::detect_contacts() {
   pair_contacts.clear();
   max_overlap_ratio = 0.0;
   for (int k = 0; k < np; ++k) {
-    if (dist[k] < 0.0) continue;
+    if (dist[k] == -1.0) continue;
     const PairEntry& p = pairs[k];
     PairContactData pc;
     pc.pair = k;
-    const double d = dist[k];
+    pc.closing = dist[k] < 0.0;
+    const double d = pc.closing ? -1.0 - dist[k] : dist[k];
     pc.overlap = s_r[p.i] + s_r[p.j] - d;
     pc.normal = d > 0.0 ? Eigen::Vector3d((s_pos[p.i] - s_pos[p.j]) / d) : Eigen::Vector3d::UnitZ();
     pc.point = s_pos[p.i] - (s_r[p.i] - 0.5 * pc.overlap) * pc.normal;
+    if (pc.closing) pc.overlap = 0.0;
     const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
     if (ratio > max_overlap_ratio) {
       max_overlap_ratio = ratio;
@@ -298,7 +305,22 @@ void World::Impl::detect_contacts() {
         used[best] = true;
         next[k].history = prev[best].history;
       }
+      out[k].closing = false;
     }
+    // Contacts that ended during the step and still owe their last damping impulse.
+    for (int j = 0; j < kWallSlots && n < kWallSlots; ++j)
+      if (!used[j] && prev[j].wall >= 0 && prev[j].history.damping != 0.0) {
+        WallContactData& wc = out[n];
+        wc.wall = prev[j].wall;
+        wc.normal = prev[j].normal;
+        wc.point = p - r * prev[j].normal;
+        wc.overlap = 0.0;
+        wc.closing = true;
+        next[n].wall = prev[j].wall;
+        next[n].normal = prev[j].normal;
+        next[n].history = prev[j].history;
+        ++n;
+      }
     wall_slots[s] = next;
     wall_contact_n[s] = n;
   }

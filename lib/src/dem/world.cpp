@@ -597,8 +597,11 @@ double World::total_mass() const {
   return m;
 }
 int World::contact_count() const {
-  int n = static_cast<int>(impl_->pair_contacts.size());
-  for (int k : impl_->wall_contact_n) n += k;
+  int n = 0;
+  for (const auto& pc : impl_->pair_contacts) n += pc.closing ? 0 : 1;
+  for (size_t s = 0; s < impl_->wall_contact_n.size(); ++s)
+    for (int k = 0; k < impl_->wall_contact_n[s]; ++k)
+      n += impl_->wall_contacts[s][k].closing ? 0 : 1;
   return n;
 }
 
@@ -606,6 +609,7 @@ std::vector<ContactInfo> World::contacts() const {
   const Impl& w = *impl_;
   std::vector<ContactInfo> out;
   for (const auto& pc : w.pair_contacts) {
+    if (pc.closing) continue;  // not a contact any more, only its last damping impulse
     const PairEntry& p = w.pairs[pc.pair];
     out.push_back(
         {w.s_clump[p.i], w.s_clump[p.j], -1, pc.point, pc.normal, pc.overlap, pc.out.force});
@@ -613,6 +617,7 @@ std::vector<ContactInfo> World::contacts() const {
   for (size_t s = 0; s < w.wall_contact_n.size(); ++s)
     for (int k = 0; k < w.wall_contact_n[s]; ++k) {
       const auto& wc = w.wall_contacts[s][k];
+      if (wc.closing) continue;
       out.push_back({w.s_clump[s], -1, wc.wall, wc.point, wc.normal, wc.overlap, wc.out.force});
     }
   return out;
@@ -641,7 +646,8 @@ std::uint64_t World::state_hash() const {
   h.vec(w.c_t);
   h.vec(w.c_mroll);
   for (size_t k = 0; k < w.pairs.size(); ++k)
-    if (!w.pair_hist[k].shear.isZero(0.0) || !w.pair_hist[k].roll.isZero(0.0)) {
+    if (!w.pair_hist[k].shear.isZero(0.0) || !w.pair_hist[k].roll.isZero(0.0) ||
+        w.pair_hist[k].damping != 0.0) {
       h.value(w.pairs[k]);
       h.value(w.pair_hist[k]);
     }

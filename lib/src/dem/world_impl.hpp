@@ -48,6 +48,7 @@ struct PairContactData {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double overlap = 0.0;
+  bool closing = false;  // overlap gone, last damping impulse only (contact_law.hpp)
   ContactForce out;
 };
 
@@ -70,6 +71,7 @@ struct WallContactData {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double overlap = 0.0;
+  bool closing = false;  // overlap gone, last damping impulse only (contact_law.hpp)
   ContactForce out;
 };
 
