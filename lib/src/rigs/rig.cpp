@@ -235,16 +235,29 @@ struct SettleInfo {
 SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
                   const std::string& what) {
   SettleInfo s;
-  const double t_begin = w.time();
+  double t_begin = w.time();
   double t_factories = w.factories_done() ? w.time() : -1.0;
   int quiet = 0;
+  // Resumed from a checkpoint taken inside this settle (same phase, same time): continue its
+  // bookkeeping, so that it ends where an uninterrupted run's does.
+  if (!c.dir.empty() && fs::exists(c.dir / "state.json")) {
+    try {
+      const auto saved = nlohmann::json::parse(read_file(c.dir / "state.json"));
+      if (saved.value("phase", 0) == phase && saved.contains("settle") &&
+          saved["settle"].value("t", -1.0) == w.time()) {
+        t_begin = saved["settle"].at("t_begin");
+        t_factories = saved["settle"].at("t_factories");
+        quiet = saved["settle"].at("quiet");
+      }
+    } catch (const nlohmann::json::exception&) {
+    }
+  }
   const double check = 0.01;
   while (true) {
     w.run_until(w.time() + check);
     if (t_factories < 0 && w.factories_done()) t_factories = w.time();
     s.rms_speed = rms_speed(w);
     quiet = (t_factories >= 0 && s.rms_speed < c.p.settle_speed) ? quiet + 1 : 0;
-    keep_checkpoint(c, w, phase, extra, false);
     if (std::chrono::duration<double>(Clock::now() - c.last_progress).count() > 5.0) {
       c.say(fmt::format("{}: t = {:.3f} s, {} clumps, rms speed {:.4f} m/s", what, w.time(),
                         w.clump_count(), s.rms_speed));
@@ -258,6 +271,11 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
     if (t_factories < 0 && w.time() - t_begin > 60.0 * c.p.settle_max)
       throw NumericalError(what + ": the factory did not finish in " +
                            fmt::format("{:.1f}", w.time() - t_begin) + " s");
+    // Checkpoint only when the loop goes on (a resume continues with the next check).
+    nlohmann::json st = extra;
+    st["settle"] = {
+        {"t", w.time()}, {"t_begin", t_begin}, {"t_factories", t_factories}, {"quiet", quiet}};
+    keep_checkpoint(c, w, phase, st, false);
   }
   s.time = w.time() - t_begin;
   return s;
