@@ -25,6 +25,7 @@ struct RigArgs {
   bool vtk = false, list = false;
   int threads = 0;
   long rays = 20000;
+  double checkpoint_interval = 60.0;
 };
 
 void list_rigs() {
@@ -72,6 +73,11 @@ Command setup(CLI::App& parent) {
   c->add_option("--threads", a->threads, "Threads (0 = all)")->check(CLI::NonNegativeNumber);
   c->add_option("--rays", a->rays, "Rays for the clumps' mass properties")
       ->check(CLI::PositiveNumber);
+  c->add_option("--checkpoint-interval", a->checkpoint_interval,
+                "Wall-clock seconds between checkpoints in --out (a killed run resumes from the "
+                "last one)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   c->add_flag("--list", a->list, "List the rigs, their quantities, settings and the effects");
   c->add_option("--write-meshes", a->meshes,
                 "Write the rigs' wall meshes (paper size, STL in metres) to this folder and exit");
@@ -107,6 +113,7 @@ Command setup(CLI::App& parent) {
             req.vtk = a->vtk;
             req.threads = a->threads;
             req.rays = a->rays;
+            req.checkpoint_interval = a->checkpoint_interval;
             if (a->vtk && a->out.empty())
               throw InputError("--vtk", "", "VTK output needs --out DIR");
             if (!a->out.empty()) {
