@@ -18,6 +18,8 @@ trap 'rm -rf "$scratch"' EXIT
 dict_for() {
   case "$1" in
     units) echo "$here/dict/units.dict" ;;
+    mesh_file) echo "$here/dict/mesh.dict" ;;
+    measurements_csv) echo "$here/dict/csv.dict" ;;
     *_json) echo "$here/dict/json.dict" ;;
     *_file) echo "$here/dict/toml.dict" ;;
     *) echo "" ;;
