@@ -107,6 +107,15 @@ void World::save_checkpoint(const std::filesystem::path& path) const {
   o.value(w.wall_work);
   o.value(w.inserted_energy);
   o.value(w.check_initialised);
+  // Trailer: the walls' motions (World::set_wall_motion may have changed them after creation).
+  // Checkpoints written before the trailer existed load with the motions of the settings.
+  o.str("wall-motions");
+  for (const WallData& wd : w.walls) {
+    o.vec(wd.motion.translation.times);
+    o.vec(wd.motion.translation.velocities);
+    o.value(static_cast<std::uint8_t>(wd.motion.rotation ? 1 : 0));
+    if (wd.motion.rotation) o.value(*wd.motion.rotation);
+  }
   write_file_atomic(path, o.buf);
 }
 
@@ -199,6 +208,26 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   in.value(w.wall_work);
   in.value(w.inserted_energy);
   in.value(w.check_initialised);
+  if (in.at < data.size()) {
+    std::string tag;
+    in.str(tag);
+    if (tag != "wall-motions") throw InputError(path.string(), "", "checkpoint is corrupt (trailer)");
+    for (WallData& wd : w.walls) {
+      WallMotion m;
+      in.vec(m.translation.times);
+      in.vec(m.translation.velocities);
+      std::uint8_t rot = 0;
+      in.value(rot);
+      if (rot) {
+        WallRotation r;
+        in.value(r);
+        m.rotation = r;
+      }
+      wd.motion = m;
+    }
+    for (size_t k = 0; k < w.walls.size(); ++k) w.settings.walls[k].motion = w.walls[k].motion;
+    w.move_walls();
+  }
   // The contacts of the saved step are re-detected (detection is a pure function of positions
   // and histories are already restored): nothing else needs them before the next force pass.
   w.pair_contacts.clear();

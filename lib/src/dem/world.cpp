@@ -359,6 +359,28 @@ int World::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quaternion
   return c;
 }
 
+void World::set_wall_motion(int w, const WallMotion& motion) {
+  Impl& im = *impl_;
+  const std::string& where = im.settings.source;
+  if (w < 0 || w >= static_cast<int>(im.walls.size()))
+    throw InputError(where, "set_wall_motion", "wall index out of range");
+  const std::string f = "walls[" + std::to_string(w) + "].motion";
+  motion.translation.validate(where, f + ".translation");
+  if (motion.rotation) {
+    const WallRotation& r = *motion.rotation;
+    if (!r.axis_point.allFinite() || !std::isfinite(r.rpm) || !std::isfinite(r.start_time))
+      throw InputError(where, f + ".rotation", "values must be finite");
+    if (!(r.axis.norm() > 0.0))
+      throw InputError(where, f + ".rotation.axis", "the axis must not be zero");
+    if (!(r.stop_time >= r.start_time))
+      throw InputError(where, f + ".rotation.stop_time", "stops before it starts");
+  }
+  im.walls[w].motion = motion;
+  im.settings.walls[w].motion = motion;
+  // The pose at the current time; a jump (if any) triggers a neighbour rebuild next step.
+  im.move_walls();
+}
+
 int World::remove_clumps(const std::function<bool(int)>& remove) {
   Impl& w = *impl_;
   const int nc = static_cast<int>(w.c_x.size());

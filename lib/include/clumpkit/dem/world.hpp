@@ -159,6 +159,12 @@ class World {
   const WallState& wall(int w) const;
   /// Current world vertices of wall w.
   const std::vector<Eigen::Vector3d>& wall_vertices(int w) const;
+  /// Replaces wall w's prescribed motion from now on (times in the motion are world times, so a
+  /// motion that starts at time() or later continues the wall's current pose without a jump
+  /// when the old motion had ended). Clumps, contact histories and the time are kept: this is how
+  /// a rig starts a scraper, a lift or a wheel once the bed has settled. Saved in checkpoints.
+  /// InputError on an invalid motion or wall index.
+  void set_wall_motion(int w, const WallMotion& motion);
 
   // Factories.
   int factory_count() const;
