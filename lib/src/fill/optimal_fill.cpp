@@ -51,6 +51,11 @@ class Optimiser {
                                    o.min_radius * 1e3, rmax * 1e3));
     const size_t stride = std::max<size_t>(1, all.size() / 60000 + 1);
     for (size_t k = 0; k < all.size(); k += stride) cand_.push_back(all[k]);
+    std::vector<std::int64_t> in;
+    for (std::int64_t i = 0; i < g.size(); ++i)
+      if (g.inside[i]) in.push_back(i);
+    const size_t stride_in = std::max<size_t>(1, in.size() / 40000 + 1);
+    for (size_t k = 0; k < in.size(); k += stride_in) inside_pts_.push_back(voxel_center(in[k]));
     threads_ = o.threads > 0 ? o.threads : omp_get_max_threads();
     step_ = 0.01 * ctx_.size;
   }
@@ -61,7 +66,7 @@ class Optimiser {
     FillResult res;
     res.tolerance = ctx_.tolerance;
     if (o_.spheres > 0 && o_.max_error <= 0) {
-      budget_mode(s);
+      budget_mode(s, o_.spheres);
     } else {
       target_mode(s, o_.spheres > 0 ? o_.spheres : o_.max_spheres);
     }
@@ -91,6 +96,58 @@ class Optimiser {
   }
 
   // ---- seeding -------------------------------------------------------------------------------
+  Eigen::Vector3d voxel_center(std::int64_t v) const {
+    const auto& g = ctx_.grid;
+    return g.center(static_cast<int>(v % g.n.x()), static_cast<int>((v / g.n.x()) % g.n.y()),
+                    static_cast<int>(v / (static_cast<std::int64_t>(g.n.x()) * g.n.y())));
+  }
+
+  // Lloyd iterations (a centroidal Voronoi tessellation of the inside volume): every centre moves
+  // to the centroid of the inside points nearest to it, then takes the largest admissible radius
+  // (capped). Spreads the spheres evenly, which the largest-first greedy does not.
+  void lloyd(Spheres& s, int iters) const {
+    const int n = static_cast<int>(s.size());
+    if (n == 0) return;
+    const int m = static_cast<int>(inside_pts_.size());
+    std::vector<int> owner(m);
+    for (int it = 0; it < iters; ++it) {
+#pragma omp parallel for num_threads(threads_) schedule(static)
+      for (int k = 0; k < m; ++k) {
+        double best = std::numeric_limits<double>::infinity();
+        int arg = 0;
+        for (int i = 0; i < n; ++i) {
+          const double d = (inside_pts_[k] - s[i].center).squaredNorm();
+          if (d < best) {
+            best = d;
+            arg = i;
+          }
+        }
+        owner[k] = arg;
+      }
+      std::vector<Eigen::Vector3d> sum(n, Eigen::Vector3d::Zero());
+      std::vector<int> cnt(n, 0);
+      for (int k = 0; k < m; ++k) {
+        sum[owner[k]] += inside_pts_[k];
+        ++cnt[owner[k]];
+      }
+      for (int i = 0; i < n; ++i)
+        if (cnt[i] > 0) s[i].center = sum[i] / cnt[i];
+    }
+    const double rmin = std::max(o_.min_radius, 1e-6 * ctx_.size);
+    for (Sphere& x : s) {
+      x.radius = std::min(ctx_.max_radius(x.center), cap_);
+      if (x.radius < rmin) {  // a centroid outside a non-convex shape: back to the nearest point
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& p : inside_pts_)
+          if ((p - x.center).squaredNorm() < best && ctx_.max_radius(p) >= rmin) {
+            best = (p - x.center).squaredNorm();
+            x.center = p;
+          }
+        x.radius = std::max(rmin, std::min(ctx_.max_radius(x.center), cap_));
+      }
+    }
+  }
+
   void mark(std::vector<std::uint8_t>& covered, const Sphere& s) const {
     const auto& g = ctx_.grid;
     const Eigen::Vector3d q = (s.center - g.origin) / g.h;
@@ -267,6 +324,82 @@ class Optimiser {
     return f;
   }
 
+  // ---- per-sphere polish ----------------------------------------------------------------------
+  // Pattern search, one sphere at a time, each with its own step: the centre along the three
+  // axes and along its own descent direction (radius kept, or grown to the largest admissible),
+  // the radius alone up and down. Moves are scored incrementally (only the rays the sphere
+  // crosses before or after) and taken when the sampled symmetric difference falls.
+  double polish(Spheres& s, int sweeps) {
+    const int n = static_cast<int>(s.size());
+    double f = objective(s);
+    if (n == 0) return f;
+    const double vs = ctx_.cache->shape_volume();
+    const double rmin = std::max(o_.min_radius, 1e-6 * ctx_.size);
+    std::vector<double> delta(n);
+    for (int i = 0; i < n; ++i) delta[i] = 0.1 * s[i].radius;
+    detail::RayCache::Local L;
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      ++iterations_;
+      const auto g = gradient(s);
+      bool active = false;
+      for (int i = 0; i < n; ++i) {
+        if (delta[i] < 2e-3 * s[i].radius) continue;
+        active = true;
+        const Sphere cur = s[i];
+        const double rho_cur = ctx_.max_radius(cur.center);
+        // Every trial sphere lies within ball(c, max(r, rho) + 2 delta): distance is 1-Lipschitz.
+        ctx_.cache->local(s, i, std::max(cur.radius, rho_cur) + 2.0 * delta[i] + 1e-9 * ctx_.size,
+                          L);
+        ++evaluations_;
+        const double base = ctx_.cache->local_value(L, cur);
+        Eigen::Vector3d dc = g[i].c;
+        if (cur.radius >= rho_cur - 1e-6 * ctx_.size && g[i].r < 0)
+          dc -= g[i].r * ctx_.distance_gradient(cur.center);
+        double best_d = -1e-9 * vs;
+        Sphere best = cur;
+        auto trial = [&](const Sphere& t) {
+          const double d = ctx_.cache->local_value(L, t) - base;
+          if (d < best_d) {
+            best_d = d;
+            best = t;
+          }
+        };
+        auto shift = [&](const Eigen::Vector3d& u, double len) {
+          Sphere t;
+          t.center = cur.center + len * u;
+          const double rho = ctx_.max_radius(t.center);
+          if (rho < rmin) return;
+          t.radius = std::max(rmin, std::min(cur.radius, rho));
+          trial(t);
+          if (rho > t.radius * (1 + 1e-9)) {
+            t.radius = rho;
+            trial(t);
+          }
+        };
+        // Trials are cheap here: the descent direction at three step lengths, the six axis
+        // directions, and the radius alone.
+        if (dc.norm() > 0)
+          for (const double k : {1.0, 0.5, 0.25}) shift(-dc.normalized(), k * delta[i]);
+        for (int a = 0; a < 3; ++a)
+          for (const double sg : {1.0, -1.0}) shift(sg * Eigen::Vector3d::Unit(a), delta[i]);
+        for (const double dr : {delta[i], -delta[i], 0.3 * delta[i], -0.3 * delta[i]}) {
+          Sphere t = cur;
+          t.radius = std::clamp(cur.radius + dr, rmin, std::max(rmin, rho_cur));
+          if (t.radius != cur.radius) trial(t);
+        }
+        if (best_d < -1e-9 * vs) {
+          s[i] = best;
+          f += best_d / vs;
+          delta[i] = std::min(1.5 * delta[i], 0.3 * s[i].radius);
+        } else {
+          delta[i] *= 0.5;
+        }
+      }
+      if (!active) break;
+    }
+    return objective(s);  // exact re-evaluation (also clears round-off of the running sum)
+  }
+
   // ---- swaps and pruning ---------------------------------------------------------------------
   // Objective increase when each sphere is removed.
   std::vector<double> contributions(const Spheres& s) {
@@ -276,33 +409,52 @@ class Optimiser {
     return d;
   }
 
-  void budget_mode(Spheres& s) {
-    const int n = o_.spheres;
+  void budget_mode(Spheres& s, int n) {
     // Multi-start: the plain coverage greedy opens with the largest sphere, which can trap the
     // descent (a flat pill); starts whose radii are capped near the equal-volume radius of n
     // spheres spread the spheres out. The best start after a short descent goes on.
     const double r_eq = std::cbrt(3.0 * ctx_.cache->shape_volume() / (4.0 * kPi * n));
-    double best_f = std::numeric_limits<double>::infinity();
-    Spheres best;
-    for (const double cap : {std::numeric_limits<double>::infinity(), 1.25 * r_eq, r_eq}) {
-      cap_ = cap;
+    const double inf = std::numeric_limits<double>::infinity();
+    struct Start {
+      double cap;
+      bool lloyd;
+    };
+    std::vector<std::pair<double, Spheres>> starts;
+    for (const Start st : {Start{inf, false}, Start{1.25 * r_eq, false}, Start{r_eq, false},
+                           Start{r_eq, true}, Start{1.5 * r_eq, true}}) {
+      cap_ = st.cap;
       step_ = 0.01 * ctx_.size;
       Spheres t;
       seed(t, n);
+      if (st.lloyd) {
+        cap_ = inf;
+        lloyd(t, 25);
+      }
       const double ft = refine(t, 15);
       history_.push_back({{"stage", "start"},
-                          {"radius_cap", std::isinf(cap) ? -1.0 : cap},
+                          {"radius_cap", std::isinf(st.cap) ? -1.0 : st.cap},
+                          {"lloyd", st.lloyd},
                           {"spheres", t.size()},
                           {"objective", ft}});
-      if (ft < best_f) {
-        best_f = ft;
-        best = std::move(t);
+      starts.emplace_back(ft, std::move(t));
+    }
+    cap_ = inf;
+    // The two best starts are descended and polished in full; the better goes on.
+    std::stable_sort(starts.begin(), starts.end(),
+                     [](const auto& x, const auto& y) { return x.first < y.first; });
+    double f = inf;
+    for (size_t k = 0; k < std::min<size_t>(2, starts.size()); ++k) {
+      Spheres t = std::move(starts[k].second);
+      step_ = 0.01 * ctx_.size;
+      refine(t, 30);
+      const double ft = polish(t, 20);
+      history_.push_back({{"stage", "descent+polish"}, {"spheres", t.size()}, {"objective", ft}});
+      if (ft < f) {
+        f = ft;
+        s = std::move(t);
       }
     }
-    cap_ = std::numeric_limits<double>::infinity();
-    s = std::move(best);
-    double f = refine(s, 40);
-    history_.push_back({{"stage", "seed+refine"}, {"spheres", s.size()}, {"objective", f}});
+    // Swaps: remove the least useful sphere, re-seed one where coverage gains most.
     const int rounds = std::clamp(120 / std::max(1, n), 2, 8);
     for (int round = 0; round < rounds && !s.empty(); ++round) {
       const auto d = contributions(s);
@@ -310,22 +462,24 @@ class Optimiser {
       Spheres t = s;
       t.erase(t.begin() + static_cast<std::ptrdiff_t>(worst));
       if (seed(t, 1) == 0) break;
-      const double saved_step = step_;
-      const double ft = refine(t, 12);
+      step_ = 0.01 * ctx_.size;
+      refine(t, 12);
+      const double ft = polish(t, 8);
       if (ft < f - 1e-6 * f) {
         s = std::move(t);
         f = ft;
         history_.push_back({{"stage", "swap"}, {"spheres", s.size()}, {"objective", f}});
       } else {
-        step_ = saved_step;
         break;
       }
     }
     // A sphere count below the budget is allowed only if the shape is fully covered already.
     if (static_cast<int>(s.size()) < n) {
       seed(s, n - static_cast<int>(s.size()));
-      f = refine(s, 20);
+      refine(s, 20);
     }
+    f = polish(s, 40);
+    history_.push_back({{"stage", "polish"}, {"spheres", s.size()}, {"objective", f}});
   }
 
   void target_mode(Spheres& s, int cap) {
@@ -355,12 +509,30 @@ class Optimiser {
       s = std::move(t);
       history_.push_back({{"stage", "prune"}, {"spheres", s.size()}, {"error", e}});
     }
+    // Search below: full budget fills (seeding starts, descent, swaps, kicks) at fewer spheres,
+    // bisecting between half the pruned count (assumed too few) and the pruned count.
+    int hi = static_cast<int>(s.size()), lo = hi / 2 - 1;
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      if (mid < 1) break;
+      Spheres t;
+      budget_mode(t, mid);
+      const double e = ctx_.errors(t).metric;
+      history_.push_back({{"stage", "budget_search"}, {"spheres", t.size()}, {"error", e}});
+      if (e <= o_.max_error) {
+        hi = static_cast<int>(t.size());
+        s = std::move(t);
+      } else {
+        lo = mid;
+      }
+    }
   }
 
   FillContext ctx_;
   FillOptions o_;
   std::vector<Eigen::Vector3d> dirs_;
   std::vector<std::int64_t> cand_;
+  std::vector<Eigen::Vector3d> inside_pts_;  // inside voxel centres (sub-sampled), for Lloyd
   int threads_ = 1;
   double step_ = 0.0;
   double cap_ = std::numeric_limits<double>::infinity();  // radius cap of seeded spheres, m

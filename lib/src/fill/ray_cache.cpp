@@ -84,34 +84,41 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
     double t;
     int kind, id;
   };
-  // The three axes are independent estimates: computed in parallel into their own slots and
-  // summed in a fixed order, so the result is bit-identical whatever the thread count.
-  struct AxisOut {
-    double xor_volume = 0.0, union_volume = 0.0;
+  // Work is split into fixed blocks of lines (kBlocks per axis, independent of the thread count),
+  // each computed into its own slot and summed in a fixed order: the result is bit-identical
+  // whatever the number of threads, and two threads share three axes evenly.
+  constexpr int kBlocks = 8;
+  struct BlockOut {
+    double xor_len = 0.0, uni_len = 0.0;
     Moments m;
     std::vector<double> cost;
   };
-  AxisOut outs[3];
-#pragma omp parallel for num_threads(std::min(threads_, 3)) schedule(static, 1)
-  for (int axis = 0; axis < 3; ++axis) {
+  std::vector<BlockOut> outs(3 * kBlocks);
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
+  for (int task = 0; task < 3 * kBlocks; ++task) {
+    const int axis = task / kBlocks, block = task % kBlocks;
     std::vector<int> count, start;
     std::vector<Chord> items;
     std::vector<Event> ev;
     IntervalList uni;
-    std::vector<double>& cost = outs[axis].cost;
+    std::vector<double>& cost = outs[task].cost;
     if (removal_cost) cost.assign(spheres.size(), 0.0);
     const Axis& A = axes_[axis];
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    const int lines = A.nu * A.nv;
-    // Two passes of a counting sort: sphere chords bucketed by line.
+    const int ib = static_cast<int>(static_cast<std::int64_t>(A.nu) * block / kBlocks);
+    const int ie = static_cast<int>(static_cast<std::int64_t>(A.nu) * (block + 1) / kBlocks);
+    if (ib >= ie) continue;
+    const int lbase = ib * A.nv, lines = (ie - ib) * A.nv;
+    // Two passes of a counting sort: sphere chords bucketed by line (local index l - lbase).
     count.assign(lines + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
       for (int id = 0; id < static_cast<int>(spheres.size()); ++id) {
         const Sphere& s = spheres[id];
         const int i0 =
-            std::max(0, static_cast<int>(std::floor((s.center[u] - s.radius - A.u0) / A.du)));
+            std::max(ib, static_cast<int>(std::floor((s.center[u] - s.radius - A.u0) / A.du)));
         const int i1 = std::min(
-            A.nu - 1, static_cast<int>(std::floor((s.center[u] + s.radius - A.u0) / A.du)));
+            ie - 1, static_cast<int>(std::floor((s.center[u] + s.radius - A.u0) / A.du)));
+        if (i0 > i1) continue;
         const int j0 =
             std::max(0, static_cast<int>(std::floor((s.center[v] - s.radius - A.v0) / A.dv)));
         const int j1 = std::min(
@@ -123,10 +130,10 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
             const double h2 = s.radius * s.radius - a * a - b * b;
             if (h2 <= 0) continue;
             if (pass == 0) {
-              ++count[l + 1];
+              ++count[l - lbase + 1];
             } else {
               const double hh = std::sqrt(h2);
-              items[start[l]++] = {s.center[axis] - hh, s.center[axis] + hh, id};
+              items[start[l - lbase]++] = {s.center[axis] - hh, s.center[axis] + hh, id};
             }
           }
       }
@@ -137,16 +144,17 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
       }
     }
     const double area = A.du * A.dv;
-    double xor_len = A.shape_total, uni_len = 0.0;
+    double xor_len = 0.0, uni_len = 0.0;
     Moments m;
-    for (int l = 0; l < lines; ++l) {
-      if (count[l + 1] == count[l]) continue;
+    for (int ll = 0; ll < lines; ++ll) {
+      if (count[ll + 1] == count[ll]) continue;
+      const int l = ll + lbase;
       ev.clear();
       for (int k = A.first[l]; k < A.first[l + 1]; ++k) {
         ev.push_back({A.shape[k].t0, 0, -1});
         ev.push_back({A.shape[k].t1, 0, -1});
       }
-      for (int k = count[l]; k < count[l + 1]; ++k) {
+      for (int k = count[ll]; k < count[ll + 1]; ++k) {
         ev.push_back({items[k].t0, 1, items[k].id});
         ev.push_back({items[k].t1, 2, items[k].id});
       }
@@ -176,31 +184,135 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
           idsum -= x.id;
         }
       }
-      // |S xor U| = |S| + |U| - 2 |S and U|; |S| is already in xor_len.
+      // |S xor U| = |S| + |U| - 2 |S and U|; |S| is added per axis below.
       xor_len += lu - 2.0 * li;
       uni_len += lu;
       if (moments) accumulate_moments(uni, axis, A.pu[l], A.pv[l], area, m);
     }
-    outs[axis].xor_volume = xor_len * area / 3.0;
-    outs[axis].union_volume = uni_len * area / 3.0;
-    for (double& c : cost) c *= area / 3.0;
+    outs[task].xor_len = xor_len;
+    outs[task].uni_len = uni_len;
+    if (moments) outs[task].m = m;
+  }
+  Eval e;
+  if (removal_cost) removal_cost->assign(spheres.size(), 0.0);
+  for (int axis = 0; axis < 3; ++axis) {
+    const Axis& A = axes_[axis];
+    const double w = A.du * A.dv / 3.0;
+    double xor_len = A.shape_total, uni_len = 0.0;
+    Moments m;
+    for (int b = 0; b < kBlocks; ++b) {
+      const BlockOut& o = outs[axis * kBlocks + b];
+      xor_len += o.xor_len;
+      uni_len += o.uni_len;
+      if (moments) m += o.m;
+      if (removal_cost && !o.cost.empty())
+        for (size_t k = 0; k < spheres.size(); ++k) (*removal_cost)[k] += o.cost[k] * w;
+    }
+    e.xor_volume += xor_len * w;
+    e.union_volume += uni_len * w;
     if (moments) {
       m.m0 /= 3.0;
       m.m1 /= 3.0;
       m.m2 /= 3.0;
-      outs[axis].m = m;
+      e.union_moments += m;
     }
   }
-  Eval e;
-  if (removal_cost) removal_cost->assign(spheres.size(), 0.0);
-  for (const AxisOut& o : outs) {
-    e.xor_volume += o.xor_volume;
-    e.union_volume += o.union_volume;
-    if (moments) e.union_moments += o.m;
-    if (removal_cost)
-      for (size_t k = 0; k < spheres.size(); ++k) (*removal_cost)[k] += o.cost[k];
-  }
   return e;
+}
+
+void RayCache::local(const Spheres& spheres, int i, double reach, Local& L) const {
+  L.lines.clear();
+  L.t.clear();
+  L.w.clear();
+  L.slope.clear();
+  L.center = spheres[i].center;
+  L.reach = reach;
+  std::vector<std::pair<double, int>> ev;
+  std::vector<int> near;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Axis& A = axes_[axis];
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const Eigen::Vector3d& c = L.center;
+    near.clear();
+    for (int id = 0; id < static_cast<int>(spheres.size()); ++id) {
+      const Sphere& s = spheres[id];
+      if (id != i && std::abs(s.center[u] - c[u]) < s.radius + reach &&
+          std::abs(s.center[v] - c[v]) < s.radius + reach)
+        near.push_back(id);
+    }
+    const int i0 = std::max(0, static_cast<int>(std::floor((c[u] - reach - A.u0) / A.du)));
+    const int i1 = std::min(A.nu - 1, static_cast<int>(std::floor((c[u] + reach - A.u0) / A.du)));
+    const int j0 = std::max(0, static_cast<int>(std::floor((c[v] - reach - A.v0) / A.dv)));
+    const int j1 = std::min(A.nv - 1, static_cast<int>(std::floor((c[v] + reach - A.v0) / A.dv)));
+    for (int a = i0; a <= i1; ++a)
+      for (int b = j0; b <= j1; ++b) {
+        const int l = a * A.nv + b;
+        const double du = A.pu[l] - c[u], dv = A.pv[l] - c[v];
+        if (du * du + dv * dv >= reach * reach) continue;
+        ev.clear();
+        for (int k = A.first[l]; k < A.first[l + 1]; ++k) {
+          ev.push_back({A.shape[k].t0, 0});
+          ev.push_back({A.shape[k].t1, 0});
+        }
+        for (int id : near) {
+          const Sphere& s = spheres[id];
+          const double x = A.pu[l] - s.center[u], y = A.pv[l] - s.center[v];
+          const double h2 = s.radius * s.radius - x * x - y * y;
+          if (h2 <= 0) continue;
+          const double hh = std::sqrt(h2);
+          ev.push_back({s.center[axis] - hh, 1});
+          ev.push_back({s.center[axis] + hh, 2});
+        }
+        std::sort(ev.begin(), ev.end(),
+                  [](const auto& x, const auto& y) { return x.first < y.first; });
+        Local::Line line{axis, A.pu[l], A.pv[l], static_cast<int>(L.t.size()), 0};
+        int cover = 0;
+        bool in_shape = false;
+        double w = 0.0, prev = ev.empty() ? 0.0 : ev[0].first, sl = 1.0;
+        for (const auto& e : ev) {
+          w += sl * (e.first - prev);
+          prev = e.first;
+          if (e.second == 0)
+            in_shape = !in_shape;
+          else if (e.second == 1)
+            ++cover;
+          else
+            --cover;
+          sl = cover > 0 ? 0.0 : (in_shape ? -1.0 : 1.0);
+          L.t.push_back(e.first);
+          L.w.push_back(w);
+          L.slope.push_back(sl);
+        }
+        line.b1 = static_cast<int>(L.t.size());
+        L.lines.push_back(line);
+      }
+  }
+}
+
+double RayCache::local_value(const Local& L, const Sphere& s) const {
+  // W(t) on a line: cumulative weight; before the first breakpoint the slope is +1 (outside).
+  auto W = [&L](const Local::Line& ln, double t) {
+    if (ln.b0 == ln.b1) return t;
+    const double* first = L.t.data() + ln.b0;
+    const double* last = L.t.data() + ln.b1;
+    const double* it = std::upper_bound(first, last, t);
+    if (it == first) return L.w[ln.b0] - (*first - t);
+    const int k = static_cast<int>(it - L.t.data()) - 1;
+    return L.w[k] + L.slope[k] * (t - L.t[k]);
+  };
+  double total[3] = {0.0, 0.0, 0.0};
+  const double r2 = s.radius * s.radius;
+  for (const Local::Line& ln : L.lines) {
+    const int u = (ln.axis + 1) % 3, v = (ln.axis + 2) % 3;
+    const double x = ln.pu - s.center[u], y = ln.pv - s.center[v];
+    const double h2 = r2 - x * x - y * y;
+    if (h2 <= 0) continue;
+    const double hh = std::sqrt(h2);
+    total[ln.axis] += W(ln, s.center[ln.axis] + hh) - W(ln, s.center[ln.axis] - hh);
+  }
+  double out = 0.0;
+  for (int axis = 0; axis < 3; ++axis) out += total[axis] * axes_[axis].du * axes_[axis].dv / 3.0;
+  return out;
 }
 
 }  // namespace clumpkit::detail

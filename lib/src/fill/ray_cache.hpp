@@ -29,6 +29,27 @@ class RayCache {
   Eval evaluate(const Spheres& spheres, bool moments = false,
                 std::vector<double>* removal_cost = nullptr) const;
 
+  /// One sphere's neighbourhood for fast trial moves: on every line within `reach` of the
+  /// sphere's centre (each axis), the weight function whose integral over a chord is that chord's
+  /// contribution to the XOR length given all the other spheres: +1 outside the shape, -1
+  /// inside, 0 where another sphere already covers. A trial sphere then costs a binary search per
+  /// line instead of a sweep over every sphere.
+  struct Local {
+    struct Line {
+      int axis;
+      double pu, pv;
+      int b0, b1;  // breakpoints [b0, b1)
+    };
+    std::vector<Line> lines;
+    std::vector<double> t, w, slope;  // breakpoint, cumulative weight there, slope after it
+    Eigen::Vector3d center;
+    double reach = 0.0;
+  };
+  void local(const Spheres& spheres, int i, double reach, Local& out) const;
+  /// XOR volume (m^3, up to a constant) with sphere `i` replaced by `s`, which must lie within
+  /// the neighbourhood's reach. Differences of two calls are exact changes of the XOR volume.
+  double local_value(const Local& L, const Sphere& s) const;
+
   double shape_volume() const { return shape_volume_; }
   const Moments& shape_moments() const { return shape_moments_; }
 
