@@ -25,10 +25,10 @@ std::string fmt_g(double v) {
   return buf;
 }
 
-// Body angular momentum π rotated by −θ about principal axis k (the body turns by +θ).
-void rotate_momentum(Eigen::Vector3d& pi, int k, double theta) {
+// Body angular momentum π rotated by −θ about principal axis k (the body turns by +θ), given
+// c = cos θ and s = sin θ.
+void rotate_momentum(Eigen::Vector3d& pi, int k, double c, double s) {
   const int a = (k + 1) % 3, b = (k + 2) % 3;
-  const double c = std::cos(theta), s = std::sin(theta);
   const double pa = pi[a], pb = pi[b];
   pi[a] = c * pa + s * pb;
   pi[b] = -s * pa + c * pb;
@@ -132,8 +132,13 @@ void World::Impl::kick_and_drift() {
       const double tau = s == 2 ? dt : h;
       const double theta = tau * pi[k] / inertia[k];
       if (theta == 0.0) continue;
-      rotate_momentum(pi, k, theta);
-      q = q * Eigen::Quaterniond(Eigen::AngleAxisd(theta, Eigen::Vector3d::Unit(k)));
+      // One sincos of θ/2 serves the quaternion and (by the double-angle formulas) the
+      // momentum rotation.
+      const double sh = std::sin(0.5 * theta), ch = std::cos(0.5 * theta);
+      rotate_momentum(pi, k, 1.0 - 2.0 * sh * sh, 2.0 * sh * ch);
+      Eigen::Quaterniond r(ch, 0.0, 0.0, 0.0);
+      r.vec()[k] = sh;
+      q = q * r;
     }
     q.normalize();
     c_q[c] = q;
@@ -183,7 +188,8 @@ void World::Impl::update_neighbours() {
 void World::Impl::detect_contacts() {
   // Sphere pairs: flag in parallel, compact in order.
   const int np = static_cast<int>(pairs.size());
-  std::vector<double> dist(np);
+  std::vector<double>& dist = scratch_dist;
+  dist.resize(np);
 #pragma omp parallel for num_threads(threads) schedule(static) if (np >= kParallelMin)
   for (int k = 0; k < np; ++k) {
     const PairEntry& p = pairs[k];
@@ -198,7 +204,9 @@ void World::Impl::detect_contacts() {
       pair_hist[k].roll.setZero();
     } else {
       dist[k] = -1.0;
-      pair_hist[k] = ContactHistory{};
+      ContactHistory& h = pair_hist[k];
+      // Most listed pairs are apart with an empty history: read, do not rewrite.
+      if (h.damping != 0.0 || !h.shear.isZero(0.0) || !h.roll.isZero(0.0)) h = ContactHistory{};
     }
   }
   pair_contacts.clear();
@@ -230,8 +238,10 @@ void World::Impl::detect_contacts() {
   // is dropped. A sphere therefore feels one contact per smooth region of a wall.
   const int ns = static_cast<int>(s_r.size());
   const double merge_cos = std::cos(10.0 * 3.14159265358979323846 / 180.0);
-  std::vector<double> ratio_s(ns, 0.0);
-  std::vector<int> overflow(ns, 0);
+  std::vector<double>& ratio_s = scratch_ratio;
+  std::vector<int>& overflow = scratch_overflow;
+  ratio_s.assign(ns, 0.0);
+  overflow.assign(ns, 0);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
     struct Cand {
@@ -239,6 +249,15 @@ void World::Impl::detect_contacts() {
       int wall, tri;
       Eigen::Vector3d point;
     };
+    if (wall_cand_start[s] == wall_cand_start[s + 1]) {
+      // No wall nearby: nothing to detect, nothing to carry over unless a contact is closing.
+      bool held = false;
+      for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
+      if (!held) {
+        wall_contact_n[s] = 0;
+        continue;
+      }
+    }
     Cand cands[32];
     int nc = 0;
     const Eigen::Vector3d& p = s_pos[s];

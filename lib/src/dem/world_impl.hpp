@@ -143,6 +143,9 @@ struct World::Impl {
   double max_overlap_ratio = 0.0;
   std::string max_overlap_what;
   bool slot_overflow_warned = false;
+  // Per-step scratch of detect_contacts (kept to avoid reallocation).
+  std::vector<double> scratch_dist, scratch_ratio;
+  std::vector<int> scratch_overflow;
 
   std::vector<FactoryRuntime> factories;
 
