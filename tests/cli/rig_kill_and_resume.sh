@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# Usage: rig_kill_and_resume.sh CLUMPKIT
+# Kill and resume of a multi-repeat rig (issue #8): runs a tiny angle_of_repose rig with two
+# repeats uninterrupted (A), then the same command (B) SIGKILLed at a random moment after the
+# first checkpoint of repeat 1 and again after the first checkpoint of repeat 2, rerunning the
+# same command each time to resume. Checks that
+#   - every repeat's observables and details (final pill count, mass, heap fit, simulated time,
+#     settle figures) and the final particle state (the heap snapshot, 9 digits per coordinate)
+#     equal those of the uninterrupted run;
+#   - repeat 1, finished before the second kill, is neither recomputed nor lost: its result.json
+#     keeps inode, mtime and content, and the rerun reports it as kept.
+set -euo pipefail
+ck="$1"
+dir="$(mktemp -d)"
+pid=""
+cleanup() { [ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$dir"; }
+trap cleanup EXIT
+# Checkpoints every 0.2 s of wall time so that short runs have several.
+args=(rig angle_of_repose --scale tiny --set mass=0.008 --set lift_speed=12000
+      --repeats 2 --seed 11 --rays 2000
+      --threads 1 --vtk --checkpoint-interval 0.2)
+RANDOM=$$
+
+"$ck" "${args[@]}" --out "$dir/a" --json "$dir/a.json" > "$dir/a.log" 2>&1 ||
+  { cat "$dir/a.log"; echo "FAIL: the uninterrupted run failed"; exit 1; }
+
+# Starts run B in the background; waits for FILE to appear, then sleeps a random 0-RANGE ms and
+# SIGKILLs it. Fails if the run ends before it could be killed.
+kill_after() {  # file range_ms
+  "$ck" "${args[@]}" --out "$dir/b" --json "$dir/b.json" >> "$dir/b.log" 2>&1 &
+  pid=$!
+  while [ ! -f "$1" ]; do
+    kill -0 "$pid" 2>/dev/null || { cat "$dir/b.log"; echo "FAIL: run ended before $1 appeared"; exit 1; }
+    sleep 0.05
+  done
+  sleep "$(awk -v r=$((RANDOM % $2)) 'BEGIN { print r / 1000 }')"
+  kill -0 "$pid" 2>/dev/null || { cat "$dir/b.log"; echo "FAIL: run ended before it was killed"; exit 1; }
+  kill -9 "$pid"
+  wait "$pid" 2>/dev/null || true
+  pid=""
+  echo "killed after $1: $(tr -d ' \n' < "$(dirname "$1")/state.json" | cut -c1-70)"
+}
+
+# 1. Inside repeat 1, after its first checkpoint.
+kill_after "$dir/b/repeat_1/state.json" 800
+[ ! -f "$dir/b/repeat_1/result.json" ] || echo "note: repeat 1 had finished before the first kill"
+# 2. Resumed; killed inside repeat 2, after its first checkpoint (repeat 1 has finished then).
+kill_after "$dir/b/repeat_2/state.json" 500
+[ -f "$dir/b/repeat_1/result.json" ] || { echo "FAIL: repeat 2 began without repeat 1's result"; exit 1; }
+[ ! -f "$dir/b/repeat_2/result.json" ] || { echo "FAIL: repeat 2 finished before the kill"; exit 1; }
+before=$(stat -c '%i %Y.%y' "$dir/b/repeat_1/result.json"; sha256sum < "$dir/b/repeat_1/result.json")
+# 3. Resumed to the end.
+: > "$dir/b.log"
+"$ck" "${args[@]}" --out "$dir/b" --json "$dir/b.json" > "$dir/b.log" 2>&1 ||
+  { cat "$dir/b.log"; echo "FAIL: the resumed run failed"; exit 1; }
+after=$(stat -c '%i %Y.%y' "$dir/b/repeat_1/result.json"; sha256sum < "$dir/b/repeat_1/result.json")
+[ "$before" = "$after" ] || { echo "FAIL: repeat 1's result.json was rewritten"; exit 1; }
+grep -q "repeat 1: kept from" "$dir/b.log" || { cat "$dir/b.log"; echo "FAIL: repeat 1 was not kept"; exit 1; }
+grep -q "resumed" "$dir/b.log" || { cat "$dir/b.log"; echo "FAIL: repeat 2 did not resume from its checkpoint"; exit 1; }
+
+# Observables and details, without wall-clock figures, the resumed flag and the engine profile
+# (timings and step counts of the last session only).
+strip() {
+  awk '/"profile": \{/ { skip = 1 } skip { if ($0 ~ /^ *\},?$/) skip = 0; next }
+       !/"wall_seconds"|"resumed"/' "$1"
+}
+fail=0
+diff <(strip "$dir/a.json") <(strip "$dir/b.json") > "$dir/json.diff" ||
+  { head -40 "$dir/json.diff"; echo "FAIL: results differ"; fail=1; }
+for k in 1 2; do
+  for f in result.json heap_spheres.vtp filled_spheres.vtp heap.png; do
+    if [ "$f" = result.json ]; then
+      diff <(strip "$dir/a/repeat_$k/$f") <(strip "$dir/b/repeat_$k/$f") > /dev/null ||
+        { echo "FAIL: repeat $k: $f differs"; fail=1; }
+    else
+      cmp -s "$dir/a/repeat_$k/$f" "$dir/b/repeat_$k/$f" ||
+        { echo "FAIL: repeat $k: $f differs (final particle state)"; fail=1; }
+    fi
+  done
+done
+[ "$fail" = 0 ] || exit 1
+grep -h '"angle"' -A1 "$dir/a.json" | head -2 | tr -d ' \n'; echo
+echo "OK: killed twice (inside repeat 1 and repeat 2), resumed; results and final states equal"
