@@ -1,18 +1,26 @@
 // fill_bench: the comparison table of issue 4 (not part of the default test run).
-//   fill_bench [--shapes a,b,...] [--counts 4,8,...] [--methods edt,optimal,paper] [--ratio E]
+//   fill_bench [--shapes a,b,...] [--counts 4,8,...] [--methods edt,optimal,paper]
+//              [--ratio E1,E2,...] [--tolerance T] [--svg FILE] [--mesh FILE.stl]
 // Prints, per shape x method x sphere count, the symmetric-difference error measured on
-// independent rays (95 % half-width) and the fill time; with --ratio E, the sphere counts each
-// method needs to reach the error target E and their ratio.
+// independent rays (95 % half-width) and the fill time; with --ratio, the sphere counts each
+// method needs to reach each error target and their ratio; with --svg, a plot of error against
+// sphere count per method (one panel per shape); with --mesh, fills a mesh file (metres) through
+// Embree instead of the test shapes.
 #include <fmt/format.h>
 
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
+#include <fstream>
+#include <map>
 #include <sstream>
 
 #include "clumpkit/fill/fill_problem.hpp"
 #include "clumpkit/fill/paper_rule.hpp"
 #include "clumpkit/fill/shape_library.hpp"
+#ifdef CLUMPKIT_BENCH_MESHES
+#include "clumpkit/raycast/target_shape.hpp"
+#endif
 
 using namespace clumpkit;
 
@@ -31,18 +39,104 @@ FillShape fill_shape(const std::string& name) {
     s.exact_distance = [solid](const Eigen::Vector3d& p) { return solid->signed_distance(p); };
   return s;
 }
+FillShape mesh_shape(const std::string& path) {
+#ifdef CLUMPKIT_BENCH_MESHES
+  TargetShape t = target_from_mesh(path, 1.0);
+  std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
+  FillShape s{solid, nullptr, path};
+  s.exact_distance = [solid](const Eigen::Vector3d& p) {  // as clumpkit fill does
+    thread_local IntervalList list;
+    solid->intervals(p, 0, list);
+    bool in = false;
+    for (const Interval& iv : list) in = in || (p.x() > iv.t0 && p.x() < iv.t1);
+    const double d = solid->surface_distance(p);
+    return in ? -d : d;
+  };
+  return s;
+#else
+  (void)path;
+  std::fprintf(stderr, "fill_bench: built without mesh support\n");
+  std::exit(2);
+#endif
+}
+
+// Error against sphere count, one panel per shape, one polyline per method (log-log axes).
+using Series = std::map<std::string, std::map<std::string, std::vector<std::pair<int, double>>>>;
+void write_svg(const std::string& path, const std::vector<std::string>& shapes, const Series& data,
+               const std::vector<int>& counts) {
+  const int cols = 4, pw = 260, ph = 200, ml = 46, mb = 30, mt = 22;
+  const int rows = (static_cast<int>(shapes.size()) + cols - 1) / cols;
+  std::ofstream o(path);
+  o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << cols * pw << "' height='"
+    << rows * ph + 30 << "' font-family='sans-serif' font-size='10'>\n"
+    << "<rect width='100%' height='100%' fill='white'/>\n";
+  const std::map<std::string, std::string> colour = {
+      {"paper", "#2ca02c"}, {"edt", "#d62728"}, {"optimal", "#1f77b4"}};
+  int cmin = 1 << 30, cmax = 1;
+  for (int c : counts) cmin = std::min(cmin, c), cmax = std::max(cmax, c);
+  const double lx0 = std::log(std::max(1, cmin)), lx1 = std::log(std::max(cmin + 1, cmax));
+  const double ly0 = std::log(0.005), ly1 = std::log(1.0);
+  for (size_t k = 0; k < shapes.size(); ++k) {
+    const int ox = static_cast<int>(k % cols) * pw, oy = static_cast<int>(k / cols) * ph;
+    const double w = pw - ml - 10, h = ph - mb - mt;
+    auto X = [&](double c) { return ox + ml + w * (std::log(c) - lx0) / (lx1 - lx0); };
+    auto Y = [&](double e) {
+      const double le = std::clamp(std::log(std::max(e, 1e-9)), ly0, ly1);
+      return oy + mt + h * (ly1 - le) / (ly1 - ly0);
+    };
+    o << fmt::format("<text x='{}' y='{}' font-weight='bold'>{}</text>\n", ox + ml, oy + 14,
+                     shapes[k]);
+    o << fmt::format(
+        "<rect x='{}' y='{}' width='{}' height='{}' fill='none' stroke='#888'/>\n", ox + ml,
+        oy + mt, w, h);
+    for (double e : {0.01, 0.03, 0.1, 0.3, 1.0})
+      o << fmt::format("<text x='{}' y='{:.1f}' text-anchor='end'>{}</text>\n", ox + ml - 3,
+                       Y(e) + 3, e);
+    for (int c : counts)
+      o << fmt::format("<text x='{:.1f}' y='{}' text-anchor='middle'>{}</text>\n", X(c),
+                       oy + mt + h + 12, c);
+    auto it = data.find(shapes[k]);
+    if (it == data.end()) continue;
+    for (const auto& [method, pts] : it->second) {
+      std::string poly;
+      for (const auto& [c, e] : pts) poly += fmt::format("{:.1f},{:.1f} ", X(c), Y(e));
+      const std::string col = colour.count(method) ? colour.at(method) : "#000";
+      o << fmt::format("<polyline points='{}' fill='none' stroke='{}' stroke-width='1.5'/>\n",
+                       poly, col);
+      for (const auto& [c, e] : pts)
+        o << fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='2.5' fill='{}'/>\n", X(c), Y(e),
+                         col);
+    }
+  }
+  int lx = 10;
+  for (const auto& [m, col] : colour) {
+    o << fmt::format("<rect x='{}' y='{}' width='12' height='4' fill='{}'/>", lx,
+                     rows * ph + 12, col)
+      << fmt::format("<text x='{}' y='{}'>{}</text>\n", lx + 16, rows * ph + 17, m);
+    lx += 80;
+  }
+  o << fmt::format("<text x='{}' y='{}'>symmetric-difference error |S xor U|/|S| (log) against "
+                   "sphere count (log), measured on 10^6 independent rays</text>\n",
+                   lx + 10, rows * ph + 17)
+    << "</svg>\n";
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> shapes = test_shape_names();
   std::vector<int> counts = {4, 8, 12, 20, 50, 100};
   std::vector<std::string> methods = {"paper", "edt", "optimal"};
-  double ratio_target = 0.0, tolerance = -1.0;
+  std::vector<double> ratio_targets;
+  double tolerance = -1.0;
+  std::string svg, mesh;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--shapes") shapes = split(v);
     if (k == "--methods") methods = split(v);
-    if (k == "--ratio") ratio_target = std::atof(v.c_str());
+    if (k == "--ratio")
+      for (const auto& e : split(v)) ratio_targets.push_back(std::atof(e.c_str()));
+    if (k == "--svg") svg = v;
+    if (k == "--mesh") mesh = v;
     if (k == "--tolerance") tolerance = std::atof(v.c_str());
     if (k == "--counts") {
       counts.clear();
@@ -54,8 +148,10 @@ int main(int argc, char** argv) {
   measure.seed = 12345;
   fmt::print("{:<18} {:<8} {:>7} {:>14} {:>10} {:>8}\n", "shape", "method", "spheres", "sym.diff",
              "ci95", "time s");
+  if (!mesh.empty()) shapes = {mesh};
+  Series series;
   for (const std::string& name : shapes) {
-    const FillShape shape = fill_shape(name);
+    const FillShape shape = mesh.empty() ? fill_shape(name) : mesh_shape(mesh);
     for (const std::string& method : methods) {
       for (int n : counts) {
         Spheres spheres;
@@ -80,10 +176,11 @@ int main(int argc, char** argv) {
         const FillMeasurement m = measure_fill(shape, spheres, measure);
         fmt::print("{:<18} {:<8} {:>7} {:>14.5f} {:>10.5f} {:>8.2f}\n", name, method,
                    spheres.size(), m.symmetric_difference.value, m.symmetric_difference.ci95, secs);
+        series[name][method].emplace_back(n, m.symmetric_difference.value);
         std::fflush(stdout);
       }
     }
-    if (ratio_target > 0) {
+    for (const double ratio_target : ratio_targets) {
       int need[2] = {0, 0};
       for (int k = 0; k < 2; ++k) {
         FillOptions o;
@@ -97,5 +194,6 @@ int main(int argc, char** argv) {
                  need[0] > 0 && need[1] > 0 ? static_cast<double>(need[0]) / need[1] : 0.0);
     }
   }
+  if (!svg.empty()) write_svg(svg, shapes, series, counts);
   return 0;
 }

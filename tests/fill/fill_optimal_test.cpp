@@ -31,9 +31,9 @@ RaySamplingOptions measuring() {
 }
 }  // namespace
 
-// The headline target: at 12 spheres on the pills, below the paper's 12-sphere rule (at the default
-// tolerance, 1 % of the size) and below the EDT baseline (both with strict containment, tolerance
-// 0, so neither gains by protruding).
+// The headline target: at 12 spheres on the pills, below the paper's 12-sphere rule and below the
+// EDT baseline, all with strict containment (tolerance 0: the paper's spheres are tangent inside,
+// so neither side gains by protruding). Margins: three times the measurement's 95 % half-widths.
 class Pill : public ::testing::TestWithParam<char> {};
 
 TEST_P(Pill, OptimiserBeatsPaperRuleAndEdtAtTwelveSpheres) {
@@ -42,28 +42,24 @@ TEST_P(Pill, OptimiserBeatsPaperRuleAndEdtAtTwelveSpheres) {
   const FillShape shape = fill_shape(std::string("pill_") + p);
   FillOptions o;
   o.spheres = 12;
+  o.tolerance = 0.0;
   const FillResult opt = optimal_fill(shape, o);
   ASSERT_EQ(opt.spheres.size(), 12u);
+  for (const Sphere& s : opt.spheres) EXPECT_LE(s.radius + shape.exact_distance(s.center), 1e-12);
   const Spheres paper = paper_fill(6e-3, h, paper_preset(regime(6e-3, h), 12));
+  const FillResult edt = edt_fill(shape, o);
+  ASSERT_EQ(edt.spheres.size(), 12u);
   const auto mo = measure_fill(shape, opt.spheres, measuring());
   const auto mp = measure_fill(shape, paper, measuring());
+  const auto me = measure_fill(shape, edt.spheres, measuring());
   double margin = 3.0 * (mo.symmetric_difference.ci95 + mp.symmetric_difference.ci95);
   EXPECT_LT(mo.symmetric_difference.value + margin, mp.symmetric_difference.value)
       << "optimal " << mo.symmetric_difference.value << " paper " << mp.symmetric_difference.value;
+  margin = 3.0 * (mo.symmetric_difference.ci95 + me.symmetric_difference.ci95);
+  EXPECT_LT(mo.symmetric_difference.value + margin, me.symmetric_difference.value)
+      << "optimal " << mo.symmetric_difference.value << " edt " << me.symmetric_difference.value;
   // The objective's own estimate agrees with the independent measurement.
   EXPECT_NEAR(opt.error, mo.symmetric_difference.value, 0.01);
-
-  o.tolerance = 0.0;
-  const FillResult strict = optimal_fill(shape, o);
-  const FillResult edt = edt_fill(shape, o);
-  ASSERT_EQ(edt.spheres.size(), 12u);
-  const auto ms = measure_fill(shape, strict.spheres, measuring());
-  const auto me = measure_fill(shape, edt.spheres, measuring());
-  margin = 3.0 * (ms.symmetric_difference.ci95 + me.symmetric_difference.ci95);
-  EXPECT_LT(ms.symmetric_difference.value + margin, me.symmetric_difference.value)
-      << "optimal " << ms.symmetric_difference.value << " edt " << me.symmetric_difference.value;
-  for (const Sphere& s : strict.spheres)
-    EXPECT_LE(s.radius + shape.exact_distance(s.center), 1e-12);
 }
 
 INSTANTIATE_TEST_SUITE_P(Pills, Pill, ::testing::Values('A', 'B', 'C'));
@@ -109,29 +105,43 @@ TEST(OptimalFill, ContainmentHoldsWithoutAnExactDistance) {
 }
 
 TEST(OptimalFill, BeatsEdtAcrossShapesAndCounts) {
-  for (const std::string name : {"ellipsoid", "cube", "torus", "bracket"})
-    for (int n : {6}) {
-      FillOptions o;
-      o.spheres = n;
-      const FillShape shape = fill_shape(name);
-      const auto mo = measure_fill(shape, optimal_fill(shape, o).spheres, measuring());
-      const auto me = measure_fill(shape, edt_fill(shape, o).spheres, measuring());
-      EXPECT_LT(mo.symmetric_difference.value, me.symmetric_difference.value) << name << " " << n;
-    }
+  struct Case {
+    const char* shape;
+    int n;
+  };
+  for (const Case c : {Case{"cube", 4}, Case{"cube", 12}, Case{"bracket", 4}, Case{"bracket", 12},
+                       Case{"ellipsoid", 8}, Case{"torus", 8}, Case{"pill_C_chamfered", 8}}) {
+    FillOptions o;
+    o.spheres = c.n;
+    const FillShape shape = fill_shape(c.shape);
+    const auto mo = measure_fill(shape, optimal_fill(shape, o).spheres, measuring());
+    const auto me = measure_fill(shape, edt_fill(shape, o).spheres, measuring());
+    EXPECT_LT(mo.symmetric_difference.value, me.symmetric_difference.value)
+        << c.shape << " " << c.n;
+  }
 }
 
-TEST(OptimalFill, ErrorTargetIsHonouredWithFewerSpheresThanEdt) {
-  const FillShape shape = fill_shape("ellipsoid");
-  FillOptions o;
-  o.max_error = 0.12;
-  const FillResult opt = optimal_fill(shape, o);
-  const FillResult edt = edt_fill(shape, o);
-  EXPECT_TRUE(opt.target_reached);
-  EXPECT_TRUE(edt.target_reached);
-  EXPECT_LE(opt.error, 0.12);
-  const auto m = measure_fill(shape, opt.spheres, measuring());
-  EXPECT_LE(m.symmetric_difference.value, 0.12 + 0.005);
-  EXPECT_LT(opt.spheres.size(), edt.spheres.size());
+// For an error target, at most half the spheres the EDT baseline needs (two smooth shapes, where
+// the count stays small enough for CI).
+TEST(OptimalFill, ErrorTargetIsHonouredWithAtMostHalfTheSpheresOfEdt) {
+  struct Case {
+    const char* shape;
+    double target;
+  };
+  for (const Case c : {Case{"ellipsoid", 0.12}, Case{"capsule", 0.07}}) {
+    const FillShape shape = fill_shape(c.shape);
+    FillOptions o;
+    o.max_error = c.target;
+    const FillResult opt = optimal_fill(shape, o);
+    const FillResult edt = edt_fill(shape, o);
+    EXPECT_TRUE(opt.target_reached) << c.shape;
+    EXPECT_TRUE(edt.target_reached) << c.shape;
+    EXPECT_LE(opt.error, c.target);
+    const auto m = measure_fill(shape, opt.spheres, measuring());
+    EXPECT_LE(m.symmetric_difference.value, c.target + 0.005) << c.shape;
+    EXPECT_LE(2 * opt.spheres.size(), edt.spheres.size())
+        << c.shape << ": optimal " << opt.spheres.size() << ", edt " << edt.spheres.size();
+  }
 }
 
 TEST(OptimalFill, VolumeMetricTarget) {

@@ -347,9 +347,8 @@ class Optimiser {
         active = true;
         const Sphere cur = s[i];
         const double rho_cur = ctx_.max_radius(cur.center);
-        // Every trial sphere lies within ball(c, max(r, rho) + 2 delta): distance is 1-Lipschitz.
-        ctx_.cache->local(s, i, std::max(cur.radius, rho_cur) + 2.0 * delta[i] + 1e-9 * ctx_.size,
-                          L);
+        // Every trial sphere lies within ball(c, r + 2 delta) (radii grow by at most delta).
+        ctx_.cache->local(s, i, cur.radius + 2.0 * delta[i] + 1e-9 * ctx_.size, L);
         ++evaluations_;
         const double base = ctx_.cache->local_value(L, cur);
         Eigen::Vector3d dc = g[i].c;
@@ -371,8 +370,9 @@ class Optimiser {
           if (rho < rmin) return;
           t.radius = std::max(rmin, std::min(cur.radius, rho));
           trial(t);
-          if (rho > t.radius * (1 + 1e-9)) {
-            t.radius = rho;
+          const double grown = std::min(rho, cur.radius + len);
+          if (grown > t.radius * (1 + 1e-9)) {
+            t.radius = grown;
             trial(t);
           }
         };
@@ -420,15 +420,19 @@ class Optimiser {
       bool lloyd;
     };
     std::vector<std::pair<double, Spheres>> starts;
+    Spheres capped;  // the r_eq-capped seeding, shared by its plain and Lloyd starts
     for (const Start st : {Start{inf, false}, Start{1.25 * r_eq, false}, Start{r_eq, false},
-                           Start{r_eq, true}, Start{1.5 * r_eq, true}}) {
+                           Start{r_eq, true}}) {
       cap_ = st.cap;
       step_ = 0.01 * ctx_.size;
       Spheres t;
-      seed(t, n);
       if (st.lloyd) {
+        t = capped;
         cap_ = inf;
         lloyd(t, 25);
+      } else {
+        seed(t, n);
+        if (st.cap == r_eq) capped = t;
       }
       const double ft = refine(t, 15);
       history_.push_back({{"stage", "start"},
@@ -447,7 +451,7 @@ class Optimiser {
       Spheres t = std::move(starts[k].second);
       step_ = 0.01 * ctx_.size;
       refine(t, 30);
-      const double ft = polish(t, 20);
+      const double ft = polish(t, 12);
       history_.push_back({{"stage", "descent+polish"}, {"spheres", t.size()}, {"objective", ft}});
       if (ft < f) {
         f = ft;
@@ -478,7 +482,7 @@ class Optimiser {
       seed(s, n - static_cast<int>(s.size()));
       refine(s, 20);
     }
-    f = polish(s, 40);
+    f = polish(s, 25);
     history_.push_back({{"stage", "polish"}, {"spheres", s.size()}, {"objective", f}});
   }
 
