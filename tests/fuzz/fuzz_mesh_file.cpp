@@ -29,10 +29,10 @@ void check_mesh(const clumpkit::TriangleMesh& m, const clumpkit::MeshReport& r, 
       CLUMPKIT_FUZZ_CHECK(t[k] >= 0 && static_cast<std::size_t>(t[k]) < m.vertices.size(),
                           "triangle index out of range");
   CLUMPKIT_FUZZ_CHECK(r.triangles == m.triangles.size(), "report triangle count");
+  for (const Eigen::Vector3d& v : m.vertices)
+    CLUMPKIT_FUZZ_CHECK(v.allFinite(), "non-finite vertex in an accepted mesh");
   if (!closed) return;
   CLUMPKIT_FUZZ_CHECK(r.closed_solid(), "accepted a mesh that is not a closed solid");
-  for (const Eigen::Vector3d& v : m.vertices)
-    CLUMPKIT_FUZZ_CHECK(v.allFinite(), "non-finite vertex in an accepted solid");
   CLUMPKIT_FUZZ_CHECK(std::isfinite(r.signed_volume) && r.signed_volume >= 0.0,
                       "accepted solid is not outward");
   CLUMPKIT_FUZZ_CHECK(std::isfinite(r.area) && r.area >= 0.0, "area");

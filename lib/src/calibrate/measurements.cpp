@@ -124,12 +124,18 @@ std::vector<Measurement> parse_measurements(const std::string& text, const std::
     const double factor = unit_factor(unit, q->dimension, where, "unit") /
                           unit_factor(q->unit == "1" ? "" : q->unit, q->dimension);
     m.unit = q->unit;
-    m.value = parse_number(cell("value"), where, "value") * factor;
+    // Finite as written can overflow in the canonical unit (1e307 rad in degrees).
+    const auto in_range = [&](double v, const char* field) {
+      if (!std::isfinite(v))
+        throw InputError(where, field, "'" + cell(field) + " " + unit + "' is out of range in " + m.unit);
+      return v;
+    };
+    m.value = in_range(parse_number(cell("value"), where, "value") * factor, "value");
     const std::string std_text = cell("std");
     if (std_text.empty())
       throw InputError(where, "std", "missing: the standard deviation of the repeats is needed to "
                                      "weigh this measurement");
-    m.std = parse_number(std_text, where, "std") * factor;
+    m.std = in_range(parse_number(std_text, where, "std") * factor, "std");
     if (m.std <= 0) throw InputError(where, "std", "must be positive (got " + std_text + ")");
     const double n = parse_number(cell("n"), where, "n");
     if (n < 1 || n != std::floor(n) || n > 1e6)

@@ -132,6 +132,10 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   MeshReport r = validate_mesh(mesh, vopt);
   r.welded_vertices = welded;
   r.collapsed_faces = collapsed;
+  // Even an open surface (a wall) must index existing vertices with finite coordinates: those
+  // defects are never usable (found by fuzzing: a PLY face "3 1 20" passed as a wall).
+  if (r.bad_indices > 0 || r.nonfinite_vertices > 0)
+    throw InputError(where, "", r.defects() + ": not a usable mesh");
   if (opt.require_closed) require_closed_solid(r, where);
   if (r.closed_solid() && r.signed_volume < 0) {
     flip_orientation(mesh);
