@@ -209,12 +209,13 @@ RunSummary run_scene(const Scene& scene, const RunOptions& o) {
     throw InputError(o.out.string(), "--out",
                      "already holds a run (state.json): resume it with --resume, or choose another "
                      "folder");
-  fs::create_directories(o.out, ec);
-  check_writable(o.out / "run.json", "--out");
   Scene s = scene;
   if (o.threads > 0) s.world.threads = o.threads;
   const double until = o.until > 0 ? o.until : s.until;
+  // The physics is validated before the output folder is created: a refused scene leaves nothing.
   dem::World world = dem::World::create(s.world);
+  fs::create_directories(o.out, ec);
+  check_writable(o.out / "run.json", "--out");
   for (const auto& w : world.warnings()) std::cerr << "sim: warning: " << w << "\n";
   write_run_json(o.out, s, o, until, s.world.threads);
   RunState st;
