@@ -5,6 +5,10 @@
 //   - leaves none of the `absent` paths and no new file at all in its scratch folder (no partial
 //     output, no temporary left behind), and leaves its input files (and any old output) as they
 //     were.
+// Numerical faults (a simulation that blows up) are the exception: a run legitimately writes its
+// series and frames up to the fault, so a case may list `outputs` folders where new files are
+// allowed; every text file in them must then be free of NaN and infinity, and `allow_warnings`
+// lets the run's own warning lines ("...warning: ...") precede the one-line diagnosis.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -22,6 +26,7 @@
 #include <ostream>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -50,6 +55,8 @@ struct Case {
   int status = 2;
   std::string stderr_regex;
   std::vector<std::string> absent;
+  std::vector<std::string> outputs;  // folders where a failing run may leave (NaN-free) files
+  bool allow_warnings = false;       // lines before the diagnosis must be warnings
   std::string load_error;  // a malformed catalogue entry becomes one failing case
 };
 
@@ -111,6 +118,8 @@ std::vector<Case> load_catalogue() {
           doc.fail(p + "stderr", std::string("not a valid regex: ") + e.what());
         }
         c.absent = doc.strings(p + "absent");
+        c.outputs = doc.strings(p + "outputs");
+        c.allow_warnings = doc.boolean_opt(p + "allow_warnings").value_or(false);
         cases.push_back(std::move(c));
       }
     } catch (const clumpkit::InputError& e) {
@@ -128,6 +137,21 @@ std::set<fs::path> regular_files(const fs::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir))
     if (!e.is_directory()) out.insert(fs::relative(e.path(), dir));
   return out;
+}
+
+/// Position of the first NaN or infinity written as a number ("nan", "-nan", "inf", "Infinity",
+/// any case, not part of a longer word such as "info"), or npos.
+size_t find_nonfinite(const std::string& text) {
+  std::string low(text);
+  std::transform(low.begin(), low.end(), low.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  const auto letter = [&](size_t i) {
+    return i < low.size() && (std::isalnum(static_cast<unsigned char>(low[i])) || low[i] == '_');
+  };
+  for (const std::string word : {"nan", "infinity", "inf"})
+    for (size_t at = low.find(word); at != std::string::npos; at = low.find(word, at + 1))
+      if ((at == 0 || !letter(at - 1)) && !letter(at + word.size())) return at;
+  return std::string::npos;
 }
 
 struct Outcome {
@@ -210,7 +234,16 @@ TEST_P(BadInput, FailsCleanly) {
   EXPECT_EQ(out.status, c.status) << "stderr:\n" << out.err;
   ASSERT_FALSE(out.err.empty()) << "no message on stderr";
   EXPECT_EQ(out.err.back(), '\n') << "message not terminated: " << out.err;
-  const std::string line = out.err.substr(0, out.err.size() - 1);
+  std::string line = out.err.substr(0, out.err.size() - 1);
+  if (c.allow_warnings) {  // "<prefix>warning: ..." lines, then the diagnosis
+    const size_t last = line.rfind('\n');
+    if (last != std::string::npos) {
+      std::istringstream warnings(line.substr(0, last));
+      for (std::string w; std::getline(warnings, w);)
+        EXPECT_NE(w.find("warning: "), std::string::npos) << "not a warning line: " << w;
+      line = line.substr(last + 1);
+    }
+  }
   EXPECT_EQ(line.find('\n'), std::string::npos) << "more than one line on stderr:\n" << out.err;
   EXPECT_TRUE(std::regex_search(line, std::regex(c.stderr_regex)))
       << "message:  " << line << "\nexpected: /" << c.stderr_regex << "/";
@@ -224,8 +257,26 @@ TEST_P(BadInput, FailsCleanly) {
     EXPECT_TRUE(now == f.content) << "file changed by a failing command: " << f.path;
   }
   const std::set<fs::path> after = regular_files(dir);
-  for (const fs::path& f : after)
-    EXPECT_TRUE(before.count(f)) << "file created by a failing command: " << f;
+  const auto in_outputs = [&](const fs::path& f) {
+    for (const std::string& o : c.outputs) {
+      const std::string rel = fs::path(expand(o)).lexically_normal().string() + "/";
+      if (f.string().rfind(rel, 0) == 0) return true;
+    }
+    return false;
+  };
+  for (const fs::path& f : after) {
+    if (before.count(f)) continue;
+    if (!in_outputs(f)) {
+      ADD_FAILURE() << "file created by a failing command: " << f;
+      continue;
+    }
+    std::ifstream in(dir / f, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (text.find('\0') != std::string::npos) continue;  // binary (a checkpoint)
+    if (const size_t at = find_nonfinite(text); at != std::string::npos)
+      ADD_FAILURE() << "non-finite number in output " << f << ": ..."
+                    << text.substr(at > 40 ? at - 40 : 0, 80) << "...";
+  }
   if (!HasFailure()) fs::remove_all(dir);
 }
 
