@@ -21,10 +21,6 @@ timed() {
   "$@"
   stage_times+=("$(printf '%-10s %4d s' "$name" $(($(date +%s) - t0)))")
 }
-# The full ASan+UBSan stage (every module, the CLI catalogue under ASan) has not yet been run to
-# the end within the CI budget on a 2-core machine, so it is opt-in for now:
-# CLUMPKIT_CI_SKIP="" bash .ci/tests.sh build runs it. TSan and fuzzing run by default.
-CLUMPKIT_CI_SKIP="${CLUMPKIT_CI_SKIP-sanitize}"
 skipped() { [ "${CLUMPKIT_CI_QUICK:-0}" = 1 ] || [[ " ${CLUMPKIT_CI_SKIP:-} " == *" $1 "* ]]; }
 
 # A clang build at -O1 with asserts on, without benchmarks; only the labelled tests get built.
