@@ -19,26 +19,20 @@ RigRequest request(const std::string& rig, const std::string& settings, const st
   r.rig = rig;
   r.model = load_model(kModels / "production.toml");
   r.settings = parse_settings(find_rig(rig), settings, "test");
-  r.threads = 2;
+  r.threads = 1;  // ctest runs tests in parallel: one thread each (results are thread-count independent)
   r.rays = 3000;
   r.out = fs::path(CLUMPKIT_BINARY_DIR) / "tests" / "rigs" / out;
   fs::remove_all(r.out);
   return r;
 }
 
-// Smaller than mini, to keep the suite short: ~100-200 pills per rig.
-void tiny(ScaleParams& p) {
-  p.cup_diameter = 0.030, p.cup_height = 0.029;
-  p.heap_mass = 0.03, p.tube_diameter = 0.036, p.tube_height = 0.09, p.lift_speed = 0.05;
-  p.settle_max = 0.5;
-  p.wheel_scale = 0.4, p.bed_mass = 0.025;
-}
-
-// Disabled: the strike-off blew up (a pill wedged between blade and rim) before the blade was
-// raised to one sphere diameter above the rim; not yet re-run with that fix (docs/rigs.md).
+// The `tiny` scale (mini made smaller, ~100-200 pills per rig) keeps the suite short.
+// Disabled: the strike-off still stops the run (mini, 2026-11-22): a pill wedged under the blade
+// (overlap 67 % of a radius with the blade one sphere diameter above the rim, 81 % between two
+// pills with the blade one pill above it; at stiffness 0.2 the engine's energy check fires).
+// See docs/rigs.md "Open".
 TEST(RigEndToEnd, DISABLED_BulkDensityOfTheProductionMix) {
-  RigRequest q = request("bulk_density", "scale=mini", "e2e_bulk");
-  q.adjust = tiny;
+  RigRequest q = request("bulk_density", "scale=tiny", "e2e_bulk");
   const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
   ASSERT_EQ(r.repeats.size(), 1u);
@@ -52,8 +46,7 @@ TEST(RigEndToEnd, DISABLED_BulkDensityOfTheProductionMix) {
 }
 
 TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
-  RigRequest q = request("angle_of_repose", "scale=mini", "e2e_aor");
-  q.adjust = tiny;
+  RigRequest q = request("angle_of_repose", "scale=tiny", "e2e_aor");
   const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
   const double deg = 180.0 / std::numbers::pi;
@@ -64,19 +57,19 @@ TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
   const fs::path dir = fs::path(CLUMPKIT_BINARY_DIR) / "tests" / "rigs" / "e2e_aor" / "repeat_1";
   EXPECT_TRUE(fs::exists(dir / "heap.png"));
   // A rerun keeps the finished repeat instead of simulating again.
-  RigRequest again = request("angle_of_repose", "scale=mini", "e2e_aor_again");
+  RigRequest again = request("angle_of_repose", "scale=tiny", "e2e_aor_again");
   again.out = dir.parent_path();
-  again.adjust = tiny;
   const RigResult r2 = run_rig(again);
   ASSERT_EQ(r2.repeats.size(), 1u);
   EXPECT_TRUE(r2.repeats[0].resumed);
   EXPECT_DOUBLE_EQ(r2.stats.at("angle").mean, r.stats.at("angle").mean);
 }
 
-// Disabled: the tiny discharge run ended with an error not yet diagnosed (docs/rigs.md).
+// Disabled: 0.17 s after the wheel starts the engine's energy check fires ("energy jumped ... with
+// no source"), most likely a pill pinched between a vane tip and the housing edge (2 mm gap, pill
+// spheres ~3 mm across). See docs/rigs.md "Open".
 TEST(RigEndToEnd, DISABLED_DischargeFillsThePockets) {
-  RigRequest q = request("discharge", "scale=mini;rpm=30;pockets=2", "e2e_discharge");
-  q.adjust = tiny;
+  RigRequest q = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge");
   const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
   const double m = r.stats.at("pocket_mass").mean;

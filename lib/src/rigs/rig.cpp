@@ -142,6 +142,17 @@ nlohmann::json params_json(const ScaleParams& p) {
 // ---------------------------------------------------------------------------------------------
 // Shared machinery: settings, checkpoints, settling, phase hand-over.
 
+// Sphere-steps are counted at every settle/action check (the sphere count changes as pills are
+// poured and removed).
+struct Meter {
+  double sphere_steps = 0.0;
+  long last_steps = 0;
+  void tick(const dem::World& w) {
+    sphere_steps += double(w.step_count() - last_steps) * double(w.sphere_count());
+    last_steps = w.step_count();
+  }
+};
+
 struct Ctx {
   const RigRequest& req;
   ScaleParams p;
@@ -151,6 +162,12 @@ struct Ctx {
   int repeat = 0;
   Clock::time_point last_checkpoint = Clock::now();
   Clock::time_point last_progress = Clock::now();
+  // Clumps whose centre satisfies `outside` have left the rig for good (overflow, discharge,
+  // fallen off the plate): removed from the World; `removed_mass` totals them (phase 2 only
+  // resumes it from the state, see discharge).
+  std::function<bool(const Vector3d&)> outside = nullptr;
+  double removed_mass = 0.0;
+  Meter meter = {};
 
   void say(const std::string& s) const {
     if (req.progress) req.progress(fmt::format("[{} repeat {}] {}", req.rig, repeat + 1, s));
@@ -222,6 +239,38 @@ double rms_speed(const dem::World& w) {
   return m > 0 ? std::sqrt(2.0 * w.kinetic_energy() / m) : 0.0;
 }
 
+// The engine's stage profile and throughput, for the JSON and the progress stream.
+nlohmann::json profile_json(const Ctx& c, const dem::World& w, double sphere_steps) {
+  const dem::Profile& pr = w.profile();
+  c.say("engine profile:\n" + pr.table());
+  return {{"steps", pr.steps},
+          {"neighbour_rebuilds", pr.neighbour_rebuilds},
+          {"engine_seconds", pr.total()},
+          {"integrate_s", pr.integrate},
+          {"walls_s", pr.walls},
+          {"insert_s", pr.insert},
+          {"neighbours_s", pr.neighbours},
+          {"contacts_s", pr.contacts},
+          {"forces_s", pr.forces},
+          {"checks_s", pr.checks},
+          {"sphere_steps_per_s", pr.total() > 0 ? sphere_steps / pr.total() : 0.0}};
+}
+
+// Removes the clumps that have left the rig; returns their mass.
+double cull(Ctx& c, dem::World& w) {
+  c.meter.tick(w);
+  if (!c.outside) return 0.0;
+  double m = 0.0;
+  const auto& x = w.positions();
+  w.remove_clumps([&](int i) {
+    if (!c.outside(x[i])) return false;
+    m += w.clump_mass(i);
+    return true;
+  });
+  c.removed_mass += m;
+  return m;
+}
+
 struct SettleInfo {
   bool settled = false;
   double time = 0.0;     // s simulated in this settle
@@ -255,6 +304,7 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
   const double check = 0.01;
   while (true) {
     w.run_until(w.time() + check);
+    cull(c, w);
     if (t_factories < 0 && w.factories_done()) t_factories = w.time();
     s.rms_speed = rms_speed(w);
     quiet = (t_factories >= 0 && s.rms_speed < c.p.settle_speed) ? quiet + 1 : 0;
@@ -283,19 +333,6 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
 
 nlohmann::json settle_json(const SettleInfo& s) {
   return {{"settled", s.settled}, {"time_s", s.time}, {"rms_speed_m_s", s.rms_speed}};
-}
-
-// Phase 2's world, seeded with the clumps of phase 1 that `keep` accepts.
-dem::World hand_over(const dem::World& from, dem::WorldSettings next,
-                     const std::function<bool(const Vector3d&)>& keep) {
-  next.factories.clear();
-  dem::World w = dem::World::create(std::move(next));
-  for (int i = 0; i < from.clump_count(); ++i) {
-    if (!keep(from.positions()[i])) continue;
-    w.add_clump(from.clump_type_of(i), from.positions()[i], from.orientations()[i],
-                from.velocities()[i], from.omega_world(i));
-  }
-  return w;
 }
 
 Spheres world_spheres(const dem::World& w) {
@@ -338,38 +375,40 @@ nlohmann::json load_state(const Ctx& c) {
   }
 }
 
-// Phase 1 (pour and settle) with resume; returns the world at the end of phase 1, or nothing
-// when the state says phase 2 has already begun.
-std::optional<dem::World> run_pour(Ctx& c, dem::WorldSettings ws, const nlohmann::json& state,
-                                   SettleInfo& info, const std::string& what) {
-  if (state.value("phase", 0) >= 2) return std::nullopt;
-  dem::World w = dem::World::create(std::move(ws));
+// The repeat's World: created from `ws` (walls at rest), then restored from the checkpoint of
+// the phase the state names, if any (the checkpoint carries the walls' motions).
+dem::World open_world(Ctx& c, const dem::WorldSettings& ws, const nlohmann::json& state,
+                      const std::string& what) {
+  dem::World w = dem::World::create(ws);
   for (const auto& m : w.warnings()) c.say("warning: " + m);
-  if (!c.dir.empty() && fs::exists(c.dir / "phase1.ckpt") && state.value("phase", 0) == 1) {
-    w.load_checkpoint(c.dir / "phase1.ckpt");
-    c.say(fmt::format("resumed {} at t = {:.3f} s", what, w.time()));
+  const int phase = state.value("phase", 0);
+  if (!c.dir.empty() && phase >= 1) {
+    const fs::path ck = c.dir / fmt::format("phase{}.ckpt", phase);
+    if (fs::exists(ck)) {
+      w.load_checkpoint(ck);
+      c.say(fmt::format("resumed {} (phase {}) at t = {:.3f} s", what, phase, w.time()));
+    }
   }
   c.say(fmt::format("{}: time step {:.3g} s", what, w.dt()));
-  info = settle(c, w, 1, {}, what);
-  c.say(fmt::format("{}: {} after {:.3f} s, {} clumps, rms speed {:.4f} m/s", what,
-                    info.settled ? "settled" : "settle time cap reached", w.time(), w.clump_count(),
-                    info.rms_speed));
+  c.meter.last_steps = w.step_count();
   return w;
 }
 
-// Phase 2: either handed over from phase 1 or restored from its checkpoint.
-dem::World start_phase2(Ctx& c, const std::optional<dem::World>& phase1,
-                        const dem::WorldSettings& ws2,
-                        const std::function<bool(const Vector3d&)>& keep, nlohmann::json& state) {
-  if (phase1) {
-    dem::World w = hand_over(*phase1, ws2, keep);
-    keep_checkpoint(c, w, 2, state, true);
-    return w;
-  }
-  dem::World w = dem::World::create(ws2);
-  w.load_checkpoint(c.dir / "phase2.ckpt");
-  c.say(fmt::format("resumed phase 2 at t = {:.3f} s", w.time()));
-  return w;
+// Phase 1: pour and settle.
+SettleInfo pour_and_settle(Ctx& c, dem::World& w, const std::string& what) {
+  SettleInfo info = settle(c, w, 1, {}, what);
+  c.say(fmt::format("{}: {} after {:.3f} s, {} clumps, rms speed {:.4f} m/s", what,
+                    info.settled ? "settled" : "settle time cap reached", w.time(), w.clump_count(),
+                    info.rms_speed));
+  return info;
+}
+
+// Phase 2 begins: the action's wall starts moving in the same World (contact histories kept).
+void start_action(Ctx& c, dem::World& w, int wall, const dem::WallMotion& m,
+                  nlohmann::json& state) {
+  w.set_wall_motion(wall, m);
+  state["phase"] = 2;
+  keep_checkpoint(c, w, 2, state, true);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -402,43 +441,42 @@ RepeatResult bulk_density(Ctx& c) {
       pour(c, dem::CylinderRegion{Vector3d(0, 0, H + 0.005), fr, fh}, pour_mass));
   // The scraper waits beside the cup; phase 2 moves it across the rim.
   const double x_start = -(R + 0.012), x_end = R + 0.02;
-  double r_max = 0.0;
-  for (const auto& t : c.types)
-    for (const auto& sp : t.clump.spheres) r_max = std::max(r_max, sp.radius);
+  // The blade clears the rim by a whole pill (its bounding-sphere diameter): a pill lying across
+  // the rim cannot be wedged between blade and rim. Blades one sphere diameter (or less) above
+  // the rim wedged such pills and the engine stopped with overlaps of 50-85 % of a radius.
+  // Pills are weighed by their centre, so what the blade leaves above the rim is not counted.
+  const double clearance = 2.0 * max_bound_radius(c);
   auto scraper = [&](double t_on) {
-    // The blade clears the rim by the largest sphere diameter, so no sphere can touch blade and
-    // rim at once (lower blades wedged pills against the rim: the engine reported a blow-up).
-    // Pills are weighed by their centre, so what the blade leaves above the rim is not counted.
     dem::WallSettings s{
-        "scraper", scraper_mesh(x_start, R + 0.02, H + 2.0 * r_max, 0.06), cup_material, {}, {}};
+        "scraper", scraper_mesh(x_start, R + 0.02, H + clearance, 0.06), cup_material, {}, {}};
     s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / p.scraper_speed,
                                          Vector3d(p.scraper_speed, 0, 0));
     return s;
   };
+
   ws.walls.push_back(scraper(1e9));
+  const int scraper_wall = int(ws.walls.size()) - 1;
+  // Pills that fell past the rim onto the catch plate no longer matter: removed as they land.
+  c.outside = [](const Vector3d& x) { return x.z() < 0.0; };
 
   nlohmann::json state = load_state(c);
-  SettleInfo s1;
-  std::optional<dem::World> w1 = run_pour(c, ws, state, s1, "pour");
-  double top = 0;
-  if (w1) {
-    for (int i = 0; i < w1->clump_count(); ++i)
-      if (w1->positions()[i].head<2>().norm() < R) top = std::max(top, w1->positions()[i].z());
-    state = {{"t0", w1->time()}, {"settle_pour", settle_json(s1)}, {"bed_top_m", top}};
-    snapshot(c, *w1, "poured");
+  dem::World w = open_world(c, ws, state, "pour");
+  if (state.value("phase", 0) < 2) {
+    const SettleInfo s1 = pour_and_settle(c, w, "pour");
+    double top = 0;
+    for (int i = 0; i < w.clump_count(); ++i)
+      if (w.positions()[i].head<2>().norm() < R) top = std::max(top, w.positions()[i].z());
+    snapshot(c, w, "poured");
+    // The scraper starts 10 ms after the bed has settled, in the same World.
+    state = {{"t_action", w.time() + 0.01}, {"settle_pour", settle_json(s1)}, {"bed_top_m", top}};
+    start_action(c, w, scraper_wall, scraper(double(state["t_action"])).motion, state);
   }
-  // Phase 2 has its own clock, starting at 0; the scraper starts 10 ms in.
-  const double t0 = 0.01;
-  dem::WorldSettings ws2 = ws;
-  ws2.walls.back() = scraper(t0);
-  // Pills that fell onto the catch plate no longer matter.
-  dem::World w = start_phase2(
-      c, w1, ws2, [](const Vector3d& x) { return x.z() > -0.001; }, state);
   if (state.value("bed_top_m", 0.0) < H)
     c.say("warning: the pour did not overflow the rim: the bulk density is a lower bound");
-  const double t_scrape = t0 + (x_end - x_start) / p.scraper_speed;
+  const double t_scrape = double(state.at("t_action")) + (x_end - x_start) / p.scraper_speed;
   while (w.time() < t_scrape) {
     w.run_until(std::min(t_scrape, w.time() + 0.02));
+    cull(c, w);
     keep_checkpoint(c, w, 2, state, false);
   }
   c.say(fmt::format("scraped at t = {:.3f} s", w.time()));
@@ -458,11 +496,13 @@ RepeatResult bulk_density(Ctx& c) {
                {"cup_volume_m3", cup.volume()},
                {"poured_mass_kg", pour_mass},
                {"bed_top_before_strike_off_m", state.value("bed_top_m", 0.0)},
+               {"blade_clearance_m", clearance},
                {"overflowed", state.value("bed_top_m", 0.0) >= H},
                {"settle_pour", state["settle_pour"]},
                {"settle_after_strike_off", settle_json(s2)},
-               {"simulated_time_s", double(state.at("t0")) + w.time()},
-               {"time_step_s", w.dt()}};
+               {"simulated_time_s", w.time()},
+               {"time_step_s", w.dt()},
+               {"profile", profile_json(c, w, c.meter.sphere_steps)}};
   return r;
 }
 
@@ -496,36 +536,63 @@ RepeatResult angle_of_repose(Ctx& c) {
     return s;
   };
   ws.walls.push_back(tube(1e9, 1e9 + 1));
-  // The factory: the tube's column (all at once when it fits), else the paper's D 60 × H 20 mm
-  // region 5 mm above the top at the pour rate.
+  // The factory: the tube's column, all at once when it holds the mass at a loose 20 % solid
+  // fraction, else at a rate (0.3 kg/s: the column empties downwards as it is refilled). The
+  // paper's D 60 × H 20 mm region above the top at the paper's slow pour would spend most of the
+  // run pouring, and cannot keep up at the faster rates (the factory reported falling behind).
   const double br = max_bound_radius(c);
   const dem::CylinderRegion column{Vector3d(0, 0, 0.002), R - 0.001, g.height - 0.004};
-  const double col_cap = dem::region_volume(column) * 0.2 * mean_union_density(c);
-  const dem::Region region =
-      p.heap_mass <= col_cap
-          ? dem::Region(column)
-          : dem::Region(dem::CylinderRegion{Vector3d(0, 0, g.height + 0.005),
-                                            std::min(0.030, R - 0.001), std::max(0.020, 2.5 * br)});
-  ws.factories.push_back(pour(c, region, p.heap_mass));
+  const dem::Region region = column;
+  dem::FactorySettings fill = pour(c, region, p.heap_mass);
+  if (fill.rate > 0) fill.rate = std::max(fill.rate, 0.3);
+  ws.factories.push_back(fill);
+
+  const int tube_wall = int(ws.walls.size()) - 1;
+  // Pills that roll off the plate have left the rig.
+  c.outside = [](const Vector3d& x) { return x.z() < -0.02; };
 
   nlohmann::json state = load_state(c);
-  SettleInfo s1;
-  std::optional<dem::World> w1 = run_pour(c, ws, state, s1, "fill");
-  if (w1) {
+  dem::World w = open_world(c, ws, state, "fill");
+  if (state.value("phase", 0) < 2) {
+    const SettleInfo s1 = pour_and_settle(c, w, "fill");
     double top = 0;
-    for (int i = 0; i < w1->clump_count(); ++i) top = std::max(top, w1->positions()[i].z());
-    state = {{"t0", w1->time()}, {"settle_fill", settle_json(s1)}, {"bed_top_m", top + br}};
-    snapshot(c, *w1, "filled");
+    for (int i = 0; i < w.clump_count(); ++i) top = std::max(top, w.positions()[i].z());
+    snapshot(c, w, "filled");
+    const double t_on = w.time() + 0.01;
+    const double lift = p.lift_height > 0 ? p.lift_height : top + br + 0.01;
+    state = {{"t_action", t_on},
+             {"t_lift_end", t_on + lift / p.lift_speed},
+             {"lift_m", lift},
+             {"fill_time_s", w.time()},
+             {"settle_fill", settle_json(s1)},
+             {"bed_top_m", top + br}};
+    start_action(c, w, tube_wall, tube(t_on, double(state["t_lift_end"])).motion, state);
   }
-  const double t0 = 0.01;  // phase 2's clock starts at 0
-  const double lift = p.lift_height > 0 ? p.lift_height : double(state.at("bed_top_m")) + 0.01;
-  const double t_lift = t0 + lift / p.lift_speed;
-  dem::WorldSettings ws2 = ws;
-  ws2.walls.back() = tube(t0, t_lift);
-  dem::World w = start_phase2(
-      c, w1, ws2, [](const Vector3d&) { return true; }, state);
+  double t_lift = state.at("t_lift_end");
+  double lift = state.at("lift_m");
+  const double t_on = state.at("t_action");
   while (w.time() < t_lift) {
     w.run_until(std::min(t_lift, w.time() + 0.02));
+    cull(c, w);
+    // The tube has done its job once its bottom edge is a pill diameter above every pill inside
+    // or below its footprint: it stops there instead of rising over the whole initial bed (the
+    // bed slumps as the tube rises, so this saves about half of the lift).
+    if (p.lift_height <= 0 && w.time() < t_lift) {
+      const double bottom = p.lift_speed * (w.time() - t_on);
+      bool touching = false;
+      for (int i = 0; i < w.clump_count() && !touching; ++i) {
+        const Vector3d& x = w.positions()[i];
+        touching = x.head<2>().norm() < R + br && x.z() + 3.0 * br > bottom;
+      }
+      if (!touching) {
+        t_lift = w.time();
+        lift = bottom;
+        w.set_wall_motion(tube_wall, tube(t_on, t_lift).motion);
+        state["t_lift_end"] = t_lift, state["lift_m"] = lift;
+        keep_checkpoint(c, w, 2, state, true);
+        c.say(fmt::format("the tube cleared the heap after a {:.1f} mm lift", 1e3 * lift));
+      }
+    }
     keep_checkpoint(c, w, 2, state, false);
     if (std::chrono::duration<double>(Clock::now() - c.last_progress).count() > 5.0) {
       c.say(fmt::format("lifting: t = {:.3f} of {:.3f} s, rms speed {:.4f} m/s", w.time(), t_lift,
@@ -566,8 +633,9 @@ RepeatResult angle_of_repose(Ctx& c) {
                {"lift_m", lift},
                {"settle_fill", state["settle_fill"]},
                {"settle_heap", settle_json(s2)},
-               {"simulated_time_s", double(state.at("t0")) + w.time()},
-               {"time_step_s", w.dt()}};
+               {"simulated_time_s", w.time()},
+               {"time_step_s", w.dt()},
+               {"profile", profile_json(c, w, c.meter.sphere_steps)}};
   if (!c.dir.empty()) heap_picture(c.dir / "heap.png", spheres, h);
   return r;
 }
@@ -627,19 +695,27 @@ RepeatResult discharge(Ctx& c) {
       Vector3d(0.5 * g.hopper_top_width - 0.002, ymax, zt + hc + g.hopper_height)};
   ws.factories.push_back(pour(c, box, p.bed_mass));
 
+  const int wheel_wall = int(ws.walls.size()) - 1;
+  // Pills below the outlet have been discharged: removed from the World, their mass counted.
+  c.outside = [z_out](const Vector3d& x) { return x.z() < z_out; };
+
   nlohmann::json state = load_state(c);
-  SettleInfo s1;
-  std::optional<dem::World> w1 = run_pour(c, ws, state, s1, "fill hopper");
-  if (w1) {
-    state = {{"t0", w1->time()}, {"settle_fill", settle_json(s1)}};
-    snapshot(c, *w1, "bed");
+  dem::World w = open_world(c, ws, state, "fill hopper");
+  if (state.value("phase", 0) < 2) {
+    const SettleInfo s1 = pour_and_settle(c, w, "fill hopper");
+    snapshot(c, w, "bed");
+    const double t_on = w.time() + 0.01;
+    // Pills that leaked through the outlet while the wheel stood still are not counted.
+    state = {{"t_action", t_on},
+             {"fill_time_s", w.time()},
+             {"settle_fill", settle_json(s1)},
+             {"leaked_kg", c.removed_mass}};
+    c.removed_mass = 0.0;
+    state["removed_kg"] = 0.0;
+    start_action(c, w, wheel_wall, wheel(t_on).motion, state);
   }
-  const double t0 = 0.01;  // phase 2's clock starts at 0
-  dem::WorldSettings ws2 = ws;
-  ws2.walls.back() = wheel(t0);
-  // Pills that leaked through the outlet while the wheel stood still are not counted.
-  dem::World w = start_phase2(
-      c, w1, ws2, [&](const Vector3d& x) { return x.z() > z_out; }, state);
+  const double t0 = state.at("t_action");
+  c.removed_mass = state.value("removed_kg", 0.0);
 
   const double omega = p.rpm * 2.0 * kPi / 60.0;  // rad/s, about +y: angles decrease
   const double pitch = 2.0 * kPi / g.pockets;
@@ -669,21 +745,23 @@ RepeatResult discharge(Ctx& c) {
   const double settle_delay = 0.05 * period;
   const double t_end = pockets[need - 1].t_close + settle_delay;
 
-  std::vector<double> fills, curve_t, curve_m;
-  size_t next = 0;
+  // Progress of phase 2 lives in the state (saved with every checkpoint), so a resumed run
+  // continues the pocket count and the discharge curve.
+  std::vector<double> fills = state.value("fills", std::vector<double>{});
+  std::vector<double> curve_t = state.value("curve_t", std::vector<double>{});
+  std::vector<double> curve_m = state.value("curve_m", std::vector<double>{});
+  size_t next = state.value("next_pocket", size_t(0));
   const double sample = period / 10.0;
-  double t_next_sample = w.time();
+  double t_next_sample = state.value("t_next_sample", w.time());
   const double L = g.length;
   while (true) {
     const double t_next_pocket = next < size_t(need) ? pockets[next].t_close + settle_delay : 1e300;
     const double target = std::min({t_end, t_next_pocket, t_next_sample});
     if (target > w.time()) w.run_until(target);
+    cull(c, w);
     if (w.time() >= t_next_sample - 1e-12) {
-      double m = 0;
-      for (int i = 0; i < w.clump_count(); ++i)
-        if (w.positions()[i].z() < z_out) m += w.clump_mass(i);
       curve_t.push_back(w.time() - t0);
-      curve_m.push_back(m);
+      curve_m.push_back(c.removed_mass);
       t_next_sample += sample;
     }
     if (next < size_t(need) && w.time() >= t_next_pocket - 1e-12) {
@@ -703,6 +781,9 @@ RepeatResult discharge(Ctx& c) {
                         w.time(), m));
       ++next;
     }
+    state["fills"] = fills, state["curve_t"] = curve_t, state["curve_m"] = curve_m;
+    state["next_pocket"] = next, state["t_next_sample"] = t_next_sample;
+    state["removed_kg"] = c.removed_mass;
     keep_checkpoint(c, w, 2, state, false);
     if (w.time() >= t_end - 1e-12 && next >= size_t(need)) break;
   }
@@ -728,9 +809,11 @@ RepeatResult discharge(Ctx& c) {
                {"curve_time_s", curve_t},
                {"curve_mass_kg", curve_m},
                {"settle_fill", state["settle_fill"]},
+               {"leaked_before_start_kg", state.value("leaked_kg", 0.0)},
                {"pills", w.clump_count()},
-               {"simulated_time_s", double(state.at("t0")) + w.time()},
-               {"time_step_s", w.dt()}};
+               {"simulated_time_s", w.time()},
+               {"time_step_s", w.dt()},
+               {"profile", profile_json(c, w, c.meter.sphere_steps)}};
   if (!c.dir.empty())
     curve_picture(c.dir / "discharge.png", {{fmt::format("{:g} rpm", p.rpm), curve_t, curve_m}},
                   "t s", "m kg");

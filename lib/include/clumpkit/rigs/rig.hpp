@@ -2,11 +2,11 @@
 /// The paper's validation rigs run through the bundled DEM engine (SPEC §7): factory → pour →
 /// settle → the rig's action → measurement, repeated with different seeds.
 ///
-/// Each repeat runs in two phases (pour and settle; then the action with the settled bed). The
-/// action's wall motion starts when the bed has settled, so phase 2 is a new World whose walls
-/// move from that time, seeded with the settled clumps (positions, orientations, velocities;
-/// the tangential contact springs restart from zero). Both phases checkpoint through the
-/// engine, so a killed run resumes where it stopped and finished repeats are kept.
+/// Each repeat runs in two phases in one World (pour and settle; then the action with the
+/// settled bed). The action's wall motion starts when the bed has settled
+/// (World::set_wall_motion), so contact histories carry over. Clumps that have left the rig
+/// (overflow, discharge) are removed as they go. Both phases checkpoint through the engine, so a
+/// killed run resumes where it stopped and finished repeats are kept.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
