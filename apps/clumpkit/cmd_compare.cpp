@@ -5,6 +5,7 @@
 
 #include <iostream>
 #include <random>
+#include <thread>
 
 #include "cli_util.hpp"
 #include "clumpkit/calibrate/diagnosis.hpp"
@@ -23,7 +24,7 @@ struct CalArgs {
   std::vector<std::string> models;
   std::string measurements, scale = "mini", json, report, cache = "clumpkit_cache", output;
   std::string effects;
-  int repeats = 2, threads = 0;
+  int repeats = 2, threads = 0, jobs = 0;
   std::uint64_t seed = 1;
   bool apply = false, quiet = false, no_suggest = false;
   double noise = 0.03;
@@ -39,7 +40,11 @@ void common_options(CLI::App* c, CalArgs& a) {
   c->add_option("--seed", a.seed, "Seed of the first repeat")->capture_default_str();
   c->add_option("--cache", a.cache, "Folder of cached rig results (nothing is simulated twice)")
       ->capture_default_str();
-  c->add_option("--threads", a.threads, "Threads per rig run (0 = all)");
+  c->add_option("--threads", a.threads, "Engine threads per rig run (0 = the engine's choice)");
+  c->add_option("--jobs", a.jobs,
+                "Rig runs made side by side, one engine thread each (0 = one per core at the "
+                "tiny and mini scales, 1 at small and paper)")
+      ->check(CLI::Range(0, 256));
   c->add_option("--json", a.json, "Write the result as JSON (FILE or -)");
   c->add_flag("--quiet", a.quiet, "No progress lines");
 }
@@ -48,6 +53,10 @@ RigSimulator make_sim(const CalArgs& a) {
   RigSimulator::Options o;
   o.cache_dir = a.cache;
   o.threads = a.threads;
+  o.jobs = a.jobs > 0 ? a.jobs
+           : (a.scale == "tiny" || a.scale == "mini")
+               ? std::max(1, static_cast<int>(std::thread::hardware_concurrency()))
+               : 1;
   if (!a.quiet) o.progress = [](const std::string& s) { std::cerr << "clumpkit: " << s << "\n"; };
   return RigSimulator(o);
 }

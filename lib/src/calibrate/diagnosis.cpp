@@ -130,16 +130,36 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   auto simulate = [&](const ParticleModel& m) {
     return simulate_measurements(sim, m, ms, o.scale, o.repeats, o.seed);
   };
+  // Runs that are known in advance are announced together, so a simulator can run them side
+  // by side; the results (and so the diagnosis) do not depend on it.
+  const std::vector<SimRequest> requests = requests_for(ms, o.scale);
+  auto prefetch = [&](const std::vector<ParticleModel>& models) {
+    std::vector<SimJob> jobs;
+    for (const auto& m : models)
+      for (const auto& r : requests) jobs.push_back({m, r});
+    sim.prefetch(jobs, o.repeats, o.seed);
+  };
   const int n = static_cast<int>(ms.size());
   const double ln_n = std::log(std::max(1, n));
 
+  const std::vector<EffectCandidate> cands = effect_candidates(base, o.effects, &d.skipped);
+  {
+    std::vector<ParticleModel> first{base};
+    for (const auto& c : cands) {
+      if (c.discrete)
+        for (double level : c.levels) first.push_back(c.apply(base, level));
+      else
+        first.push_back(c.apply(base, c.probe));
+    }
+    say(fmt::format("{} model variants to simulate first (baseline, probes, levels)", first.size()));
+    prefetch(first);
+  }
   say("baseline model " + base.name);
   const Values s0 = simulate(base);
   d.baseline = compare(ms, s0, 0);
   d.baseline_bic = d.baseline.bic;
   d.baseline_p = chi2_survival(d.baseline.chi2, n);
 
-  const std::vector<EffectCandidate> cands = effect_candidates(base, o.effects, &d.skipped);
   struct Work {
     EffectCandidate c;
     Surrogate s;
@@ -176,18 +196,37 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(),
             [&](size_t a, size_t b) { return work[a].fit.chi2 < work[b].fit.chi2; });
-  for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r) {
-    Work& w = work[order[r]];
-    if (w.c.discrete) continue;
-    for (int step = 0; step < o.refinements; ++step) {
-      say(fmt::format("{}: refining at {}", w.c.effect, w.c.format(w.fit.theta)));
-      Values v = simulate(w.c.apply(base, w.fit.theta));
-      w.s.add(w.fit.theta, v);
-      const Fit next = fit_surrogate(ms, s0, w.s, w.c.lo, w.c.hi);
-      const bool converged = std::abs(next.theta - w.fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
-      w.fit = next;
-      if (converged) break;
+  // Step by step over the leading candidates (each candidate's sequence is its own, so the
+  // order does not change any result), so that one step's runs can go side by side.
+  std::vector<Work*> refining;
+  for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r)
+    if (!work[order[r]].c.discrete) refining.push_back(&work[order[r]]);
+  for (int step = 0; step < o.refinements && !refining.empty(); ++step) {
+    std::vector<ParticleModel> models;
+    for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
+    prefetch(models);
+    std::vector<Work*> still;
+    for (Work* w : refining) {
+      say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
+      Values v = simulate(w->c.apply(base, w->fit.theta));
+      w->s.add(w->fit.theta, v);
+      const Fit next = fit_surrogate(ms, s0, w->s, w->c.lo, w->c.hi);
+      const bool converged =
+          std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
+      w->fit = next;
+      if (!converged) still.push_back(w);
     }
+    refining = still;
+  }
+  {  // the confirmation runs below, side by side
+    std::vector<ParticleModel> models;
+    for (const Work& w : work) {
+      if (w.have_at_fit) continue;
+      bool found = false;
+      for (const auto& [t, v] : w.s.points) found = found || t == w.fit.theta;
+      if (!found) models.push_back(w.c.apply(base, w.fit.theta));
+    }
+    prefetch(models);
   }
   // Every candidate's reported chi2 comes from a real simulation at its fitted value.
   for (Work& w : work) {
@@ -285,6 +324,13 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       return sample_of_rig.count(x.rig) > sample_of_rig.count(y.rig);
     });
     if (static_cast<int>(trial.size()) > o.suggest_max) trial.resize(o.suggest_max);
+    try {
+      std::vector<SimJob> jobs;
+      for (const auto& r : trial) jobs.push_back({ma, r}), jobs.push_back({mb, r});
+      sim.prefetch(jobs, o.repeats, o.seed);
+    } catch (const std::exception&) {
+      // Each trial is retried below on its own, and skipped if it fails.
+    }
     for (const auto& r : trial) {
       say(fmt::format("suggestion: trying {} [{}]", r.rig, format_settings(r.settings)));
       SimValues va, vb;

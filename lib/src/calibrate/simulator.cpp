@@ -4,6 +4,9 @@
 
 #include <nlohmann/json.hpp>
 #include <algorithm>
+#include <atomic>
+#include <optional>
+#include <thread>
 #include <set>
 #include <sstream>
 
@@ -74,8 +77,11 @@ std::map<std::string, SimulatedValue> simulate_measurements(Simulator& sim,
                                                             const std::string& scale, int repeats,
                                                             std::uint64_t seed) {
   std::map<std::string, SimValues> by_request;
-  for (const SimRequest& r : requests_for(ms, scale))
-    by_request[r.key()] = sim.simulate(model, r, repeats, seed);
+  const std::vector<SimRequest> requests = requests_for(ms, scale);
+  std::vector<SimJob> jobs;
+  for (const SimRequest& r : requests) jobs.push_back({model, r});
+  sim.prefetch(jobs, repeats, seed);
+  for (const SimRequest& r : requests) by_request[r.key()] = sim.simulate(model, r, repeats, seed);
   std::map<std::string, SimulatedValue> out;
   for (const auto& m : ms) {
     SimRequest r{m.rig, m.sample, m.setting};
@@ -134,48 +140,62 @@ std::string model_fingerprint(const ParticleModel& m) {
 
 RigSimulator::RigSimulator(Options options) : opt_(std::move(options)) {}
 
-SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& req, int repeats,
-                                 std::uint64_t seed) {
-  const ParticleModel m = model_for_sample(model, req.sample, model.path.string());
-  const std::string fp = model_fingerprint(m);
-  const std::string key = fmt::format("{}|{}|{}|{}", req.key(), seed, repeats, fp);
-  const std::string id = fmt::format("{:016x}", std::hash<std::string>{}(key));
-  const fs::path file = opt_.cache_dir / (req.rig + "_" + id + ".json");
-  const fs::path run_dir = opt_.cache_dir / ("run_" + req.rig + "_" + id);
-  folders_.push_back(run_dir);
+RigSimulator::Entry RigSimulator::entry(const ParticleModel& model, const SimRequest& req,
+                                        int repeats, std::uint64_t seed) const {
+  Entry e;
+  e.model = model_for_sample(model, req.sample, model.path.string());
+  e.key = fmt::format("{}|{}|{}|{}", req.key(), seed, repeats, model_fingerprint(e.model));
+  const std::string id = fmt::format("{:016x}", std::hash<std::string>{}(e.key));
+  e.file = opt_.cache_dir / (req.rig + "_" + id + ".json");
+  e.run_dir = opt_.cache_dir / ("run_" + req.rig + "_" + id);
+  return e;
+}
+
+namespace {
+// The cached values of an entry, if its file exists, is readable and holds this very key.
+std::optional<SimValues> read_cached(const fs::path& file, const std::string& key) {
   std::error_code ec;
-  if (fs::exists(file, ec)) {
-    try {
-      const json j = json::parse(read_file(file));
-      if (j.value("key", "") == key) {
-        ++hits_;
-        SimValues v;
-        for (const auto& [q, x] : j.at("values").items())
-          v[q] = {x.at("mean").get<double>(), x.at("std").get<double>(), x.at("n").get<int>()};
-        return v;
-      }
-    } catch (const std::exception&) {
-      // A damaged cache entry is recomputed.
-    }
+  if (!fs::exists(file, ec)) return std::nullopt;
+  try {
+    const json j = json::parse(read_file(file));
+    if (j.value("key", "") != key) return std::nullopt;
+    SimValues v;
+    for (const auto& [q, x] : j.at("values").items())
+      v[q] = {x.at("mean").get<double>(), x.at("std").get<double>(), x.at("n").get<int>()};
+    return v;
+  } catch (const std::exception&) {
+    return std::nullopt;  // a damaged cache entry is recomputed
   }
+}
+}  // namespace
+
+SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, std::uint64_t seed,
+                            int threads) {
+  std::error_code ec;
   fs::create_directories(opt_.cache_dir, ec);
   rigs::RigRequest rr;
   rr.rig = req.rig;
-  rr.model = m;
+  rr.model = e.model;
   rr.settings = req.settings;
   rr.repeats = repeats;
   rr.seed = seed;
-  rr.threads = opt_.threads;
+  rr.threads = threads;
   rr.rays = opt_.rays;
-  rr.out = run_dir;
-  rr.progress = opt_.progress;
+  rr.out = e.run_dir;
   if (opt_.progress)
+    rr.progress = [this](const std::string& s) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      opt_.progress(s);
+    };
+  if (opt_.progress) {
+    std::lock_guard<std::mutex> lock(mutex_);
     opt_.progress(fmt::format("simulating {} sample {} [{}] model {} x{}", req.rig, req.sample,
-                              format_settings(req.settings), model.name, repeats));
+                              format_settings(req.settings), e.model.name, repeats));
+  }
   const rigs::RigResult r = rigs::run_rig(rr);
   if (!r.error.empty())
-    throw NumericalError(fmt::format("rig {} for model {} failed: {}", req.rig, model.name, r.error));
-  ++runs_;
+    throw NumericalError(
+        fmt::format("rig {} for model {} failed: {}", req.rig, e.model.name, r.error));
   std::map<std::string, double> mean, sd;
   int n = 0;
   for (const auto& [q, st] : r.stats) {
@@ -186,8 +206,57 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
   SimValues v = to_canonical(req.rig, mean, sd, n);
   json values = json::object();
   for (const auto& [q, x] : v) values[q] = {{"mean", x.mean}, {"std", x.std}, {"n", x.n}};
-  write_file_atomic(file, json{{"key", key}, {"values", values}, {"result", r.to_json()}}.dump(1));
+  write_file_atomic(e.file, json{{"key", e.key}, {"values", values}, {"result", r.to_json()}}.dump(1));
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++runs_;
   return v;
+}
+
+SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& req, int repeats,
+                                 std::uint64_t seed) {
+  const Entry e = entry(model, req, repeats, seed);
+  folders_.push_back(e.run_dir);
+  if (auto v = read_cached(e.file, e.key)) {
+    ++hits_;
+    return *v;
+  }
+  return run(e, req, repeats, seed, opt_.threads);
+}
+
+void RigSimulator::prefetch(const std::vector<SimJob>& jobs, int repeats, std::uint64_t seed) {
+  if (opt_.jobs <= 1) return;  // simulate() runs them one by one, with opt_.threads each
+  struct Pending {
+    Entry e;
+    SimRequest req;
+  };
+  std::vector<Pending> todo;
+  std::set<fs::path> seen;
+  for (const SimJob& j : jobs) {
+    Entry e = entry(j.model, j.request, repeats, seed);
+    if (!seen.insert(e.file).second || read_cached(e.file, e.key)) continue;
+    todo.push_back({std::move(e), j.request});
+  }
+  if (todo.size() < 2) return;
+  std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr first_error;
+  auto worker = [&] {
+    for (size_t i; !failed && (i = next++) < todo.size();) {
+      try {
+        run(todo[i].e, todo[i].req, repeats, seed, 1);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!first_error) first_error = std::current_exception();
+        failed = true;
+      }
+    }
+  };
+  const size_t workers = std::min<size_t>(static_cast<size_t>(opt_.jobs), todo.size());
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers; ++w) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  if (first_error) std::rethrow_exception(first_error);
 }
 
 std::vector<fs::path> RigSimulator::pictures() const {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -28,11 +29,23 @@ struct SimRequest {
 /// Quantity name -> simulated value in the quantity's canonical unit (deg, kg/m^3, kg, 1, kg/s).
 using SimValues = std::map<std::string, SimulatedValue>;
 
+/// One rig run the calibration loop will ask for: a model (whole, as given to simulate()) and
+/// a request.
+struct SimJob {
+  ParticleModel model;
+  SimRequest request;
+};
+
 class Simulator {
  public:
   virtual ~Simulator() = default;
   virtual SimValues simulate(const ParticleModel& model, const SimRequest& request, int repeats,
                              std::uint64_t seed) = 0;
+  /// Announces runs that will be asked for next, so that a simulator may run them concurrently
+  /// and serve the later simulate() calls from its cache. Results never depend on it.
+  virtual void prefetch(const std::vector<SimJob>& jobs, int repeats, std::uint64_t seed) {
+    (void)jobs, (void)repeats, (void)seed;
+  }
   /// Number of simulate() calls that really ran (not served from a cache).
   long runs() const { return runs_; }
 
@@ -63,21 +76,38 @@ class RigSimulator final : public Simulator {
  public:
   struct Options {
     std::filesystem::path cache_dir = "clumpkit_cache";
-    int threads = 0;
+    int threads = 0;  ///< engine threads per rig run (0 = the engine's choice)
+    /// Rig runs made at the same time by prefetch() (each with one engine thread): small rigs
+    /// gain more from running side by side than from threads inside one run.
+    int jobs = 1;
     long rays = 20000;
     std::function<void(const std::string&)> progress;
   };
   explicit RigSimulator(Options options);
   SimValues simulate(const ParticleModel& model, const SimRequest& request, int repeats,
                      std::uint64_t seed) override;
+  /// Runs the jobs not yet in the cache, `Options::jobs` at a time; the first failure is
+  /// rethrown after the running ones finish (no new ones start).
+  void prefetch(const std::vector<SimJob>& jobs, int repeats, std::uint64_t seed) override;
   long cache_hits() const { return hits_; }
   /// PNG pictures (heap silhouettes, discharge curves) of the runs served so far.
   std::vector<std::filesystem::path> pictures() const;
 
  private:
+  struct Entry {
+    ParticleModel model;  ///< restricted to the request's sample
+    std::string key;
+    std::filesystem::path file, run_dir;
+  };
+  Entry entry(const ParticleModel& model, const SimRequest& request, int repeats,
+              std::uint64_t seed) const;
+  SimValues run(const Entry& e, const SimRequest& request, int repeats, std::uint64_t seed,
+                int threads);
+
   Options opt_;
   long hits_ = 0;
   std::vector<std::filesystem::path> folders_;
+  std::mutex mutex_;  ///< guards runs_, folders_ and progress output during prefetch()
 };
 
 /// Converts a rig result's SI statistics to canonical-unit simulated values per quantity.
