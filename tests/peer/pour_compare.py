@@ -359,7 +359,10 @@ def analyse(spheres, a):
 def run(cmd, cwd, logfile):
     t0 = time.time()
     with open(logfile, "w") as f:
-        p = subprocess.run(cmd, cwd=cwd, stdout=f, stderr=subprocess.STDOUT)
+        try:
+            p = subprocess.run(cmd, cwd=cwd, stdout=f, stderr=subprocess.STDOUT)
+        except OSError as e:
+            raise RuntimeError("cannot run %s: %s" % (cmd[0], e))
     wall = time.time() - t0
     if p.returncode != 0:
         tail = open(logfile).read()[-3000:]
