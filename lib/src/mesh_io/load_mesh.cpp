@@ -5,7 +5,9 @@
 
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <cctype>
 #include <cstdint>
+#include <fstream>
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
@@ -83,6 +85,41 @@ std::size_t weld_vertices(TriangleMesh& mesh, double tol, std::size_t* collapsed
   return merged;
 }
 
+namespace {
+
+// assimp 5.2 loops forever on a PLY header that never reaches "end_header" (found by fuzzing: a
+// corrupted property line). PLY headers are checked here first: assimp picks its PLY reader by
+// extension or by a leading "ply", so both are checked. Every header line must start with a PLY
+// keyword and the header must end with "end_header".
+void check_ply_header(const fs::path& path, const std::string& where) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line)) return;
+  const auto trim = [](std::string& l) {
+    while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
+    const size_t b = l.find_first_not_of(" \t");
+    l = b == std::string::npos ? std::string() : l.substr(b);
+  };
+  trim(line);
+  std::string ext = path.extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (line.rfind("ply", 0) != 0 && ext != ".ply") return;
+  if (line != "ply") throw InputError(where, "", "not a PLY file (the first line must be 'ply')");
+  for (int n = 2; std::getline(in, line); ++n) {
+    trim(line);
+    if (line == "end_header") return;
+    const std::string word = line.substr(0, line.find_first_of(" \t"));
+    if (word != "format" && word != "element" && word != "property" && word != "comment" &&
+        word != "obj_info")
+      throw InputError(where, "line " + std::to_string(n),
+                       "malformed PLY header (expected format, element, property, comment or "
+                       "end_header)");
+  }
+  throw InputError(where, "", "PLY header without end_header");
+}
+
+}  // namespace
+
 TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshReport* report) {
   const std::string where = path.string();
   if (!(opt.scale > 0) || !std::isfinite(opt.scale))
@@ -91,6 +128,7 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   if (!fs::is_regular_file(path, ec)) throw InputError(where, "", "no such mesh file");
   if (fs::file_size(path, ec) == 0) throw InputError(where, "", "empty file (no triangles)");
 
+  check_ply_header(path, where);
   Assimp::Importer importer;
   // Only triangles and points/lines are of interest; normals, UVs and materials are not read.
   const aiScene* scene =
