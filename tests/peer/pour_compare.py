@@ -120,8 +120,12 @@ def liggghts_deck(a, seed_index, snippet, template_id, cup_stl, steps):
         "fix pdd all particledistribution/discrete %d 1 %s 1.0" % (p2, template_id),
         "region factory cylinder z 0 0 %.6g %.6g %.6g units box"
         % (a.region_radius, a.region_z0, a.region_z0 + a.region_height),
+        # orientation random: LIGGGHTS's default inserts every clump in the template's
+        # orientation; clumpkit's factory draws uniformly random orientations. (The keyword must
+        # come before insert/pack's own keywords.)
         "fix ins all insert/pack seed %d distributiontemplate pdd maxattempt 1000 "
-        "insert_every once overlapcheck yes all_in yes particles_in_region %d region factory"
+        "insert_every once overlapcheck yes all_in yes orientation random "
+        "particles_in_region %d region factory"
         % (p, a.pills),
         "fix integr all multisphere",
         "compute ke all ke",
