@@ -284,6 +284,19 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L) cons
           L.slope.push_back(sl);
         }
         line.b1 = static_cast<int>(L.t.size());
+        // A line whose reach is wholly covered by other spheres adds nothing for any trial: drop.
+        const double lo = c[axis] - reach, hi = c[axis] + reach;
+        bool zero = line.b1 > line.b0 && L.t[line.b0] < lo;
+        for (int k = line.b0; zero && k < line.b1; ++k) {
+          const double seg_end = k + 1 < line.b1 ? L.t[k + 1] : 1e300;
+          if (seg_end > lo && L.t[k] < hi && L.slope[k] != 0.0) zero = false;
+        }
+        if (zero) {
+          L.t.resize(line.b0);
+          L.w.resize(line.b0);
+          L.slope.resize(line.b0);
+          continue;
+        }
         L.lines.push_back(line);
       }
   }
