@@ -27,11 +27,7 @@ RigRequest request(const std::string& rig, const std::string& settings, const st
 }
 
 // The `tiny` scale (mini made smaller, ~100-200 pills per rig) keeps the suite short.
-// Disabled: the strike-off still stops the run (mini, 2026-11-22): a pill wedged under the blade
-// (overlap 67 % of a radius with the blade one sphere diameter above the rim, 81 % between two
-// pills with the blade one pill above it; at stiffness 0.2 the engine's energy check fires).
-// See docs/rigs.md "Open".
-TEST(RigEndToEnd, DISABLED_BulkDensityOfTheProductionMix) {
+TEST(RigEndToEnd, BulkDensityOfTheProductionMix) {
   RigRequest q = request("bulk_density", "scale=tiny", "e2e_bulk");
   const RigResult r = run_rig(q);
   ASSERT_TRUE(r.error.empty()) << r.error;
