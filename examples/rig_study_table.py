@@ -9,6 +9,10 @@ def load(name):
     p = out / f"{name}.json"
     return json.loads(p.read_text()) if p.exists() else None
 
+def pm(v, digits):
+    """mean ± std, or the bare value when there was one repeat (no spread to report)."""
+    return f"{v[0]:.{digits}f} ± {v[1]:.{digits}f}" if v[2] > 1 else f"{v[0]:.{digits}f}"
+
 def q(j, k):
     s = j["quantities"].get(k) if j else None
     return (s["mean"], s["std"], s["n"], s["unit"]) if s else None
@@ -22,9 +26,9 @@ for m in models:
     scale = scale or (bd or aor or {}).get("scale")
     cells = []
     b = q(bd, "bulk_density")
-    cells.append(f"{b[0]:.0f} ± {b[1]:.0f} (n={b[2]})" if b else (bd or {}).get("error", "not run")[:60])
+    cells.append(f"{pm(b, 0)} (n={b[2]})" if b else (bd or {}).get("error", "not run")[:60])
     a, al, ar = q(aor, "angle"), q(aor, "angle_left"), q(aor, "angle_right")
-    cells.append(f"{a[0]:.1f} ± {a[1]:.1f} ({al[0]:.1f} / {ar[0]:.1f}, n={a[2]})" if a else
+    cells.append(f"{pm(a, 1)} ({al[0]:.1f} / {ar[0]:.1f}, n={a[2]})" if a else
                  (aor or {}).get("error", "not run")[:60])
     md.append(f"| {m} | {m.split('_')[1][1:]} | " + " | ".join(cells) + " |")
     for rig, j, ks in (("bulk_density", bd, ["bulk_density"]), ("angle_of_repose", aor, ["angle", "angle_left", "angle_right"])):
@@ -34,10 +38,10 @@ for m in models:
 md += ["", "| model | rpm | pocket mass kg (paper pocket) | CV | mass flow kg/s |", "|---|---|---|---|---|"]
 for rpm in (10, 15, 30):
     d = load(f"dis_{rpm}")
-    pm, cv, mf = q(d, "pocket_mass"), q(d, "pocket_mass_cv"), q(d, "mass_flow")
-    if pm:
-        md.append(f"| production | {rpm} | {pm[0]:.3f} ± {pm[1]:.3f} (n={pm[2]}) | {cv[0]:.3f} ± {cv[1]:.3f} | {mf[0]:.3f} ± {mf[1]:.3f} |")
-        for k, v in (("pocket_mass", pm), ("pocket_mass_cv", cv), ("mass_flow", mf)):
+    m_, cv, mf = q(d, "pocket_mass"), q(d, "pocket_mass_cv"), q(d, "mass_flow")
+    if m_:
+        md.append(f"| production | {rpm} | {pm(m_, 3)} (n={m_[2]}) | {pm(cv, 3)} | {pm(mf, 3)} |")
+        for k, v in (("pocket_mass", m_), ("pocket_mass_cv", cv), ("mass_flow", mf)):
             rows.append(["discharge", "mix", f"rpm={rpm};scale={d['scale']}", k, *v, "production"])
     else:
         md.append(f"| production | {rpm} | {(d or {}).get('error', 'not run')[:60]} | | |")
