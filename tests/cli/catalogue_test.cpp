@@ -204,6 +204,12 @@ TEST_P(BadInput, FailsCleanly) {
   const Case& c = GetParam();
   ASSERT_TRUE(c.load_error.empty()) << "malformed catalogue: " << c.load_error;
   if (c.needs_non_root && ::geteuid() == 0) GTEST_SKIP() << "root ignores file permissions";
+#ifdef __clang__
+  // LLVM's libomp (clang builds: the sanitizer stage) registers itself in a /dev/shm file at its
+  // first parallel region; under RLIMIT_FSIZE that mapping cannot grow and the write SIGBUSes
+  // inside libomp. The disk-full cases run in the gcc (libgomp) build.
+  if (c.fsize_limit) GTEST_SKIP() << "RLIMIT_FSIZE breaks libomp's start-up (clang build)";
+#endif
   SCOPED_TRACE(c.origin + " (" + c.name + ")");
 
   const fs::path dir = fs::path(CLUMPKIT_BINARY_DIR) / "tests" / "cli" / "scratch" / c.name;
