@@ -4,6 +4,7 @@
 // exercise the threaded contact, wall and integration loops.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "clumpkit/dem/world.hpp"
@@ -39,9 +40,13 @@ std::uint64_t run(int threads) {
   f.velocity = Eigen::Vector3d(0, 0, -1.0);
   s.factories.push_back(f);
   World w = World::create(s);
-  for (int i = 0; i < 3000; ++i) w.step();
+  int most = 0;
+  for (int i = 0; i < 3000; ++i) {
+    w.step();
+    most = std::max(most, w.contact_count());
+  }
   EXPECT_EQ(w.clump_count(), 20);
-  EXPECT_GT(w.contact_count(), 0) << "the workload should have contacts";
+  EXPECT_GT(most, 0) << "the workload should have contacts";
   return w.state_hash();
 }
 
