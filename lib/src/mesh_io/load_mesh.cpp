@@ -132,7 +132,8 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   Assimp::Importer importer;
   // Only triangles and points/lines are of interest; normals, UVs and materials are not read.
   const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices);
+      importer.ReadFile(path.string(), aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                           aiProcess_PreTransformVertices);
   if (!scene) {
     throw InputError(
         where, "",
