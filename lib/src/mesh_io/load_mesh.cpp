@@ -165,6 +165,9 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   const double diag = box.isEmpty() ? 0.0 : box.diagonal().norm();
   std::size_t collapsed = 0;
   const std::size_t welded = weld_vertices(mesh, opt.weld_tolerance * diag, &collapsed);
+  if (mesh.triangles.empty())  // every triangle collapsed (found by fuzzing: accepted as a wall)
+    throw InputError(where, "", "empty mesh (all " + std::to_string(collapsed) +
+                                    " triangles are degenerate)");
 
   MeshValidateOptions vopt;
   vopt.check_self_intersections = opt.check_self_intersections;
