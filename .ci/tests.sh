@@ -35,7 +35,8 @@ sanitize_stage() {
   echo "== sanitizers: ASan + UBSan ($dir/, tests labelled 'sanitize')"
   configure_clang "$dir" address,undefined ON
   cmake --build "$dir" -j "$jobs" --target tests_sanitize fuzz_targets
-  ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:strict_init_order=1" \
+  LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp" \
+    ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:strict_init_order=1" \
     UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
     ctest --test-dir "$dir" -L sanitize -LE slow --output-on-failure -j 2 --timeout 900
 }

@@ -25,6 +25,8 @@ dict_for() {
     *) echo "" ;;
   esac
 }
+# Leaks inside third-party libraries (assimp) are suppressed, ours are not (lsan.supp).
+export LSAN_OPTIONS="suppressions=$here/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 failed=0
 for t in "${targets[@]}"; do
   bin="$build/tests/fuzz/fuzz_$t"
