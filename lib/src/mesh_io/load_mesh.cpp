@@ -8,6 +8,8 @@
 #include <cctype>
 #include <cstdint>
 #include <fstream>
+#include <set>
+#include <sstream>
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
@@ -114,6 +116,19 @@ void check_ply_header(const fs::path& path, const std::string& where) {
       throw InputError(where, "line " + std::to_string(n),
                        "malformed PLY header (expected format, element, property, comment or "
                        "end_header)");
+    if (word == "property") {
+      // An unknown type made assimp abort() later (found by fuzzing): types are checked here.
+      static const std::set<std::string> types = {
+          "char",  "uchar", "short",  "ushort", "int",     "uint",    "float",   "double",
+          "int8",  "uint8", "int16",  "uint16", "int32",   "uint32",  "float32", "float64"};
+      std::istringstream words(line);
+      std::string p, t1, t2, t3;
+      words >> p >> t1 >> t2 >> t3;
+      const bool ok = t1 == "list" ? types.count(t2) && types.count(t3) : types.count(t1) > 0;
+      if (!ok)
+        throw InputError(where, "line " + std::to_string(n),
+                         "malformed PLY header (unknown property type)");
+    }
   }
   throw InputError(where, "", "PLY header without end_header");
 }
