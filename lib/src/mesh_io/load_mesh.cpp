@@ -146,9 +146,11 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   check_ply_header(path, where);
   Assimp::Importer importer;
   // Only triangles and points/lines are of interest; normals, UVs and materials are not read.
+  // No assimp post-processing: its steps (Triangulate, PreTransformVertices, even the structure
+  // validation) abort() on corrupt scenes (found by fuzzing). Polygons are fanned here and every
+  // index is checked by validate_mesh; the formats read here have no node transforms.
   const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_ValidateDataStructure | aiProcess_Triangulate |
-                                           aiProcess_PreTransformVertices);
+      importer.ReadFile(path.string(), 0);
   if (!scene) {
     throw InputError(
         where, "",
@@ -166,10 +168,13 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
     }
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines bound no volume
-      mesh.triangles.emplace_back(base + static_cast<int>(face.mIndices[0]),
-                                  base + static_cast<int>(face.mIndices[1]),
-                                  base + static_cast<int>(face.mIndices[2]));
+      if (face.mNumIndices < 3 || !face.mIndices) continue;  // points and lines bound no volume
+      const auto index = [&](unsigned k) {
+        const unsigned i = face.mIndices[k];
+        return i < am->mNumVertices ? base + static_cast<int>(i) : -1;  // -1: a bad index
+      };
+      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)  // a fan for polygons
+        mesh.triangles.emplace_back(index(0), index(k), index(k + 1));
     }
   }
   if (mesh.triangles.empty()) throw InputError(where, "", "empty mesh (no triangles)");
