@@ -61,9 +61,10 @@ TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
   EXPECT_DOUBLE_EQ(r2.stats.at("angle").mean, r.stats.at("angle").mean);
 }
 
-// Disabled: 0.17 s after the wheel starts the engine's energy check fires ("energy jumped ... with
-// no source"), most likely a pill pinched between a vane tip and the housing edge (2 mm gap, pill
-// spheres ~3 mm across). See docs/rigs.md "Open".
+// Disabled: the engine's energy check fires shortly after the wheel starts ("energy jumped ...
+// with no source"), most likely a pill pinched at a vane. At stiffness 0.2 the CLI's tiny run
+// (20 000 rays) completed but this one (3000 rays) and mini did not: not robust yet.
+// See docs/rigs.md "Open".
 TEST(RigEndToEnd, DISABLED_DischargeFillsThePockets) {
   RigRequest q = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge");
   const RigResult r = run_rig(q);
