@@ -116,6 +116,19 @@ void check_ply_header(const fs::path& path, const std::string& where) {
       throw InputError(where, "line " + std::to_string(n),
                        "malformed PLY header (expected format, element, property, comment or "
                        "end_header)");
+    if (word == "element") {
+      // A huge count made assimp allocate tens of GB (found by fuzzing): every element takes at
+      // least one byte of the file.
+      std::istringstream words(line);
+      std::string e, name;
+      long long count = -1;
+      words >> e >> name >> count;
+      std::error_code ec;
+      const auto size = fs::file_size(path, ec);
+      if (count < 0 || ec || static_cast<unsigned long long>(count) > size)
+        throw InputError(where, "line " + std::to_string(n),
+                         "malformed PLY header (element count missing or larger than the file)");
+    }
     if (word == "property") {
       // An unknown type made assimp abort() later (found by fuzzing): types are checked here.
       static const std::set<std::string> types = {
