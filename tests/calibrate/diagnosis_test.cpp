@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "clumpkit/core/error.hpp"
 #include "fake_simulator.hpp"
 
 using namespace clumpkit;
@@ -104,6 +105,39 @@ TEST(Diagnosis, NoFalseVerdictWhenNothingIsMissing) {
     EXPECT_TRUE(d.consistent) << d.summary();
     EXPECT_TRUE(d.verdict.empty());
   }
+}
+
+// A candidate whose variant the rigs cannot measure (e.g. a heap that spreads flat) is ruled out
+// with its reason; the diagnosis goes on with the others.
+TEST(Diagnosis, ACandidateThatCannotBeSimulatedIsSkippedWithItsReason) {
+  struct Failing final : Simulator {
+    double base_wall = 0.0;
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      // Any wall friction other than the baseline's cannot be measured.
+      const auto wall = m.effects.wall_friction;
+      if (wall && wall->count("galvanized_steel") && wall->at("galvanized_steel") != base_wall)
+        throw NumericalError("heap angle: the heap is too flat to measure");
+      ++runs_;
+      return inner.simulate(m, r, repeats, seed);
+    }
+  } sim;
+  ParticleModel base = base_model();
+  set_model_effect(base, "effects.rolling_friction", "off", "test");
+  sim.base_wall = base.effects.wall_friction->at("galvanized_steel");
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
+  const auto ms = synthesize(sim.inner, truth, 0.02, 77);
+  DiagnoseOptions o;
+  o.suggest = false;
+  o.effects = {"rolling_friction", "wall_friction", "cohesion"};
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  EXPECT_EQ(d.verdict, "rolling_friction") << d.summary();
+  for (const auto& c : d.candidates) EXPECT_NE(c.candidate.effect, "wall_friction");
+  ASSERT_FALSE(d.skipped.empty());
+  EXPECT_NE(d.skipped.front().find("wall_friction"), std::string::npos);
+  EXPECT_NE(d.skipped.front().find("too flat"), std::string::npos);
 }
 
 TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {

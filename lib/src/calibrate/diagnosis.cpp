@@ -7,6 +7,7 @@
 #include <limits>
 #include <set>
 
+#include "clumpkit/core/error.hpp"
 #include "clumpkit/rigs/catalogue.hpp"
 
 namespace clumpkit::calibrate {
@@ -137,7 +138,11 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     std::vector<SimJob> jobs;
     for (const auto& m : models)
       for (const auto& r : requests) jobs.push_back({m, r});
-    sim.prefetch(jobs, o.repeats, o.seed);
+    try {
+      sim.prefetch(jobs, o.repeats, o.seed);
+    } catch (const NumericalError&) {
+      // The failing run is made again where it is needed, and handled there.
+    }
   };
   const int n = static_cast<int>(ms.size());
   const double ln_n = std::log(std::max(1, n));
@@ -166,10 +171,14 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     Fit fit;
     Values at_fit;
     bool have_at_fit = false;
+    bool dropped = false;  ///< a run at its fitted value failed (reason in d.skipped)
   };
   std::vector<Work> work;
   for (const auto& c : cands) {
-    Work w{c, {}, {}, {}, false};
+    Work w{c, {}, {}, {}, false, false};
+    // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
+    // the candidate out with the reason; it does not end the diagnosis.
+    try {
     if (c.discrete) {
       double best = std::numeric_limits<double>::infinity();
       for (size_t i = 0; i < c.levels.size(); ++i) {
@@ -188,6 +197,11 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       w.s.add(c.baseline, s0);
       w.s.add(c.probe, simulate(c.apply(base, c.probe)));
       w.fit = fit_surrogate(ms, s0, w.s, c.lo, c.hi);
+    }
+    } catch (const NumericalError& e) {
+      say(fmt::format("{}: not tried: {}", c.effect, e.what()));
+      d.skipped.push_back(c.effect + ": its variant could not be simulated: " + e.what());
+      continue;
     }
     work.push_back(std::move(w));
   }
@@ -208,7 +222,16 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     std::vector<Work*> still;
     for (Work* w : refining) {
       say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
-      Values v = simulate(w->c.apply(base, w->fit.theta));
+      Values v;
+      try {
+        v = simulate(w->c.apply(base, w->fit.theta));
+      } catch (const NumericalError& e) {
+        say(fmt::format("{}: dropped: {}", w->c.effect, e.what()));
+        d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
+                            w->c.format(w->fit.theta) + " failed: " + e.what());
+        w->dropped = true;
+        continue;
+      }
       w->s.add(w->fit.theta, v);
       const Fit next = fit_surrogate(ms, s0, w->s, w->c.lo, w->c.hi);
       const bool converged =
@@ -221,7 +244,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   {  // the confirmation runs below, side by side
     std::vector<ParticleModel> models;
     for (const Work& w : work) {
-      if (w.have_at_fit) continue;
+      if (w.have_at_fit || w.dropped) continue;
       bool found = false;
       for (const auto& [t, v] : w.s.points) found = found || t == w.fit.theta;
       if (!found) models.push_back(w.c.apply(base, w.fit.theta));
@@ -230,6 +253,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   }
   // Every candidate's reported chi2 comes from a real simulation at its fitted value.
   for (Work& w : work) {
+    if (w.dropped) continue;
     if (!w.have_at_fit) {
       bool found = false;
       for (const auto& [t, v] : w.s.points)
@@ -239,7 +263,13 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         }
       if (!found) {
         say(fmt::format("{}: confirming at {}", w.c.effect, w.c.format(w.fit.theta)));
-        w.at_fit = simulate(w.c.apply(base, w.fit.theta));
+        try {
+          w.at_fit = simulate(w.c.apply(base, w.fit.theta));
+        } catch (const NumericalError& e) {
+          d.skipped.push_back(w.c.effect + ": the run at its fitted value " +
+                              w.c.format(w.fit.theta) + " failed: " + e.what());
+          continue;
+        }
         w.s.add(w.fit.theta, w.at_fit);
       }
     }
