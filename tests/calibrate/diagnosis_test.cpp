@@ -13,8 +13,8 @@ using namespace clumpkit::calibrate;
 namespace {
 
 ParticleModel base_model() {
-  ParticleModel m = load_model(CLUMPKIT_SOURCE_DIR "/shapes/models/paper_A12.toml",
-                               CLUMPKIT_SOURCE_DIR);
+  ParticleModel m =
+      load_model(CLUMPKIT_SOURCE_DIR "/shapes/models/paper_A12.toml", CLUMPKIT_SOURCE_DIR);
   return m;
 }
 

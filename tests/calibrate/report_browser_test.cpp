@@ -122,13 +122,14 @@ TEST(ReportInBrowser, RendersOfflineWithTablesPlotsAndVerdict) {
   EXPECT_FALSE(std::regex_search(html, std::regex(R"((src|href)\s*=\s*"https?:)")));
 
   // The DOM after the browser has parsed and laid it out.
-  const std::string flags = " --headless --no-sandbox --disable-gpu --no-first-run "
-                            "--disable-extensions --user-data-dir=" +
-                            (kWork / "profile").string();
+  const std::string flags =
+      " --headless --no-sandbox --disable-gpu --no-first-run "
+      "--disable-extensions --user-data-dir=" +
+      (kWork / "profile").string();
   const fs::path dom = kWork / "dom.html", shot = kWork / "shot.png";
   const std::string url = "file://" + fs::absolute(page).string();
-  int rc = std::system((browser + flags + " --dump-dom " + url + " > " + dom.string() +
-                        " 2> " + (kWork / "dump.err").string())
+  int rc = std::system((browser + flags + " --dump-dom " + url + " > " + dom.string() + " 2> " +
+                        (kWork / "dump.err").string())
                            .c_str());
   ASSERT_EQ(rc, 0) << text(kWork / "dump.err");
   const std::string d = text(dom);

@@ -119,7 +119,9 @@ std::string observable_name(const Measurement& m) {
 
 }  // namespace
 
-double chi2_survival(double x, int dof) { return gamma_q(0.5 * dof, 0.5 * x); }
+double chi2_survival(double x, int dof) {
+  return gamma_q(0.5 * dof, 0.5 * x);
+}
 
 Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms, Simulator& sim,
                    const DiagnoseOptions& o) {
@@ -156,7 +158,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       else
         first.push_back(c.apply(base, c.probe));
     }
-    say(fmt::format("{} model variants to simulate first (baseline, probes, levels)", first.size()));
+    say(fmt::format("{} model variants to simulate first (baseline, probes, levels)",
+                    first.size()));
     prefetch(first);
   }
   say("baseline model " + base.name);
@@ -179,25 +182,25 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
     // the candidate out with the reason; it does not end the diagnosis.
     try {
-    if (c.discrete) {
-      double best = std::numeric_limits<double>::infinity();
-      for (size_t i = 0; i < c.levels.size(); ++i) {
-        say(fmt::format("{}: {}", c.effect, c.level_names[i]));
-        Values v = simulate(c.apply(base, c.levels[i]));
-        const double chi2 = compare(ms, v, 1).chi2;
-        if (chi2 < best) {
-          best = chi2;
-          w.fit = {c.levels[i], chi2, 0.0};
-          w.at_fit = v;
-          w.have_at_fit = true;
+      if (c.discrete) {
+        double best = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < c.levels.size(); ++i) {
+          say(fmt::format("{}: {}", c.effect, c.level_names[i]));
+          Values v = simulate(c.apply(base, c.levels[i]));
+          const double chi2 = compare(ms, v, 1).chi2;
+          if (chi2 < best) {
+            best = chi2;
+            w.fit = {c.levels[i], chi2, 0.0};
+            w.at_fit = v;
+            w.have_at_fit = true;
+          }
         }
+      } else {
+        say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
+        w.s.add(c.baseline, s0);
+        w.s.add(c.probe, simulate(c.apply(base, c.probe)));
+        w.fit = fit_surrogate(ms, s0, w.s, c.lo, c.hi);
       }
-    } else {
-      say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
-      w.s.add(c.baseline, s0);
-      w.s.add(c.probe, simulate(c.apply(base, c.probe)));
-      w.fit = fit_surrogate(ms, s0, w.s, c.lo, c.hi);
-    }
     } catch (const NumericalError& e) {
       say(fmt::format("{}: not tried: {}", c.effect, e.what()));
       d.skipped.push_back(c.effect + ": its variant could not be simulated: " + e.what());
@@ -281,7 +284,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     r.delta_chi2 = d.baseline.chi2 - r.comparison.chi2;
     r.bic = r.comparison.chi2 + ln_n;
     const double span = w.c.hi - w.c.lo;
-    r.at_bound = !w.c.discrete && (r.fitted <= w.c.lo + 0.01 * span || r.fitted >= w.c.hi - 0.01 * span);
+    r.at_bound =
+        !w.c.discrete && (r.fitted <= w.c.lo + 0.01 * span || r.fitted >= w.c.hi - 0.01 * span);
     r.plausible = w.c.discrete || (r.fitted >= w.c.lo && r.fitted <= w.c.hi && !r.at_bound);
     d.candidates.push_back(r);
   }
@@ -332,12 +336,14 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       SimRequest r{m.rig, m.sample, m.setting};
       if (!r.settings.count("scale")) r.settings["scale"] = o.scale;
       measured.insert(r.key());
-      if (m.value != 0) rel_std[m.quantity] = std::max(rel_std[m.quantity], m.std / std::abs(m.value));
+      if (m.value != 0)
+        rel_std[m.quantity] = std::max(rel_std[m.quantity], m.std / std::abs(m.value));
       sample_of_rig.emplace(m.rig, m.sample);
     }
     std::vector<SimRequest> trial;
     for (const auto& rig : rig_catalogue()) {
-      const std::string sample = sample_of_rig.count(rig.name) ? sample_of_rig[rig.name] : ms.front().sample;
+      const std::string sample =
+          sample_of_rig.count(rig.name) ? sample_of_rig[rig.name] : ms.front().sample;
       for (const auto& st : rig.settings) {
         std::vector<std::string> values = st.choices;
         if (st.key == "rpm") values = {"10", "15", "30"};

@@ -2,13 +2,13 @@
 
 #include <fmt/format.h>
 
-#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <atomic>
+#include <nlohmann/json.hpp>
 #include <optional>
-#include <thread>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
@@ -20,7 +20,9 @@ namespace clumpkit::calibrate {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string SimRequest::key() const { return rig + "|" + sample + "|" + format_settings(settings); }
+std::string SimRequest::key() const {
+  return rig + "|" + sample + "|" + format_settings(settings);
+}
 
 ParticleModel model_for_sample(const ParticleModel& model, const std::string& sample,
                                const std::string& where) {
@@ -37,8 +39,8 @@ ParticleModel model_for_sample(const ParticleModel& model, const std::string& sa
   }
   if (m.types.empty())
     throw InputError(where, "sample",
-                     "model '" + model.name + "' has no pill type '" + sample + "' (types: " + known +
-                         "; use sample 'mix' for the whole population)");
+                     "model '" + model.name + "' has no pill type '" + sample +
+                         "' (types: " + known + "; use sample 'mix' for the whole population)");
   if (m.types.size() < model.types.size()) m.effects.size_distribution = false;
   return m;
 }
@@ -88,8 +90,7 @@ std::map<std::string, SimulatedValue> simulate_measurements(Simulator& sim,
     if (!r.settings.count("scale")) r.settings["scale"] = scale;
     const SimValues& v = by_request.at(r.key());
     auto it = v.find(m.quantity);
-    if (it == v.end())
-      throw NumericalError("rig " + m.rig + " produced no value of " + m.quantity);
+    if (it == v.end()) throw NumericalError("rig " + m.rig + " produced no value of " + m.quantity);
     out[m.key()] = it->second;
   }
   return out;
@@ -114,7 +115,9 @@ std::string model_fingerprint(const ParticleModel& m) {
     s << "type " << t.name << " " << t.shape.diameter << " " << t.shape.height << " "
       << t.shape.density << " " << t.mass_fraction << " " << t.paper_spheres.value_or(0) << " "
       << t.given_mass.value_or(0.0) << " ";
-    if (!t.clump_path.empty()) s << read_file(t.clump_path).size() << ":" << std::hash<std::string>{}(read_file(t.clump_path));
+    if (!t.clump_path.empty())
+      s << read_file(t.clump_path).size() << ":"
+        << std::hash<std::string>{}(read_file(t.clump_path));
     s << "\n";
   }
   const ModelEffects& e = m.effects;
@@ -129,7 +132,8 @@ std::string model_fingerprint(const ParticleModel& m) {
   partners("rolling_friction", e.rolling_friction);
   partners("wall_friction", e.wall_friction);
   partners("restitution", e.restitution);
-  s << "particle_friction " << (e.particle_friction ? fmt::format("{:.17g}", *e.particle_friction) : "absent") << "\n";
+  s << "particle_friction "
+    << (e.particle_friction ? fmt::format("{:.17g}", *e.particle_friction) : "absent") << "\n";
   s << "cohesion " << (e.cohesion ? fmt::format("{:.17g}", *e.cohesion) : "absent") << "\n";
   s << "shape_resolution " << e.shape_resolution.value_or(0) << "\n";
   s << "size_distribution " << e.size_distribution << "\n";
@@ -206,7 +210,8 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
   SimValues v = to_canonical(req.rig, mean, sd, n);
   json values = json::object();
   for (const auto& [q, x] : v) values[q] = {{"mean", x.mean}, {"std", x.std}, {"n", x.n}};
-  write_file_atomic(e.file, json{{"key", e.key}, {"values", values}, {"result", r.to_json()}}.dump(1));
+  write_file_atomic(e.file,
+                    json{{"key", e.key}, {"values", values}, {"result", r.to_json()}}.dump(1));
   std::lock_guard<std::mutex> lock(mutex_);
   ++runs_;
   return v;
