@@ -170,4 +170,16 @@ TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return m;
 }
 
+void WallMotion::validate(const std::string& where, const std::string& field) const {
+  translation.validate(where, field + ".translation");
+  if (!rotation) return;
+  const WallRotation& r = *rotation;
+  if (!r.axis_point.allFinite() || !std::isfinite(r.rpm) || !std::isfinite(r.start_time))
+    throw InputError(where, field + ".rotation", "values must be finite");
+  if (!(r.axis.norm() > 0.0))
+    throw InputError(where, field + ".rotation.axis", "the axis must not be zero");
+  if (!(r.stop_time >= r.start_time))
+    throw InputError(where, field + ".rotation.stop_time", "stops before it starts");
+}
+
 }  // namespace clumpkit::dem

@@ -117,16 +117,7 @@ World World::create(WorldSettings s) {
     const std::string f = "walls[" + std::to_string(k) + "]";
     const WallSettings& ws = s.walls[k];
     ws.mesh.validate(where, f + ".mesh");
-    ws.motion.translation.validate(where, f + ".motion.translation");
-    if (ws.motion.rotation) {
-      const WallRotation& r = *ws.motion.rotation;
-      if (!r.axis_point.allFinite() || !std::isfinite(r.rpm) || !std::isfinite(r.start_time))
-        throw InputError(where, f + ".motion.rotation", "values must be finite");
-      if (!(r.axis.norm() > 0.0))
-        throw InputError(where, f + ".motion.rotation.axis", "the axis must not be zero");
-      if (!(r.stop_time >= r.start_time))
-        throw InputError(where, f + ".motion.rotation.stop_time", "stops before it starts");
-    }
+    ws.motion.validate(where, f + ".motion");
     for (size_t u = 0; u < k; ++u)
       if (s.walls[u].name == ws.name)
         throw InputError(where, f + ".name", "duplicate wall name '" + ws.name + "'");
@@ -384,17 +375,7 @@ void World::set_wall_motion(int w, const WallMotion& motion) {
   const std::string& where = im.settings.source;
   if (w < 0 || w >= static_cast<int>(im.walls.size()))
     throw InputError(where, "set_wall_motion", "wall index out of range");
-  const std::string f = "walls[" + std::to_string(w) + "].motion";
-  motion.translation.validate(where, f + ".translation");
-  if (motion.rotation) {
-    const WallRotation& r = *motion.rotation;
-    if (!r.axis_point.allFinite() || !std::isfinite(r.rpm) || !std::isfinite(r.start_time))
-      throw InputError(where, f + ".rotation", "values must be finite");
-    if (!(r.axis.norm() > 0.0))
-      throw InputError(where, f + ".rotation.axis", "the axis must not be zero");
-    if (!(r.stop_time >= r.start_time))
-      throw InputError(where, f + ".rotation.stop_time", "stops before it starts");
-  }
+  motion.validate(where, "walls[" + std::to_string(w) + "].motion");
   im.walls[w].motion = motion;
   im.settings.walls[w].motion = motion;
   // The pose at the current time; a jump (if any) triggers a neighbour rebuild next step.

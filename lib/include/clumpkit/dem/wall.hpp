@@ -50,6 +50,8 @@ struct WallRotation {
 struct WallMotion {
   VelocityProfile translation;
   std::optional<WallRotation> rotation;
+  /// Throws InputError naming `where` and `field` (e.g. "walls[2].motion") for a bad motion.
+  void validate(const std::string& where, const std::string& field) const;
 };
 
 struct WallSettings {
