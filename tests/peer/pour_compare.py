@@ -384,6 +384,8 @@ def loadavg():
 
 def run_liggghts(a, k, work, snippet, template_id, cup, steps):
     d = os.path.join(work, "liggghts_seed%d" % (k + 1))
+    if not a.reuse:
+        shutil.rmtree(d, ignore_errors=True)
     os.makedirs(d, exist_ok=True)
     for f in os.listdir(os.path.dirname(snippet)):
         shutil.copy(os.path.join(os.path.dirname(snippet), f), d)
@@ -411,6 +413,8 @@ def run_liggghts(a, k, work, snippet, template_id, cup, steps):
 
 def run_clumpkit(a, k, work, template, cup, until):
     d = os.path.join(work, "clumpkit_seed%d" % (k + 1))
+    if not a.reuse:
+        shutil.rmtree(d, ignore_errors=True)  # a fresh run each time (sim refuses an old --out)
     os.makedirs(d, exist_ok=True)
     shutil.copy(template, d)
     shutil.copy(cup, d)
