@@ -40,16 +40,8 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   const bool mesh_ext = ext == ".stl" || ext == ".STL" || ext == ".obj" || ext == ".OBJ" ||
                         ext == ".ply" || ext == ".PLY" || ext == ".off" || ext == ".OFF";
   auto from_surface = [](auto solid, const std::string& where) {
-    FillShape s{solid, nullptr, where};
-    s.exact_distance = [solid](const Eigen::Vector3d& p) {
-      thread_local IntervalList list;
-      solid->intervals(p, 0, list);
-      bool in = false;
-      for (const Interval& iv : list) in = in || (p.x() > iv.t0 && p.x() < iv.t1);
-      const double d = solid->surface_distance(p);
-      return in ? -d : d;
-    };
-    return s;
+    return fill_shape_with_surface_distance(
+        solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); }, where);
   };
   std::error_code ec;
   if (mesh_ext) {

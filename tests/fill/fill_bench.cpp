@@ -43,16 +43,8 @@ FillShape mesh_shape(const std::string& path) {
 #ifdef CLUMPKIT_BENCH_MESHES
   TargetShape t = target_from_mesh(path, 1.0);
   std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
-  FillShape s{solid, nullptr, path};
-  s.exact_distance = [solid](const Eigen::Vector3d& p) {  // as clumpkit fill does
-    thread_local IntervalList list;
-    solid->intervals(p, 0, list);
-    bool in = false;
-    for (const Interval& iv : list) in = in || (p.x() > iv.t0 && p.x() < iv.t1);
-    const double d = solid->surface_distance(p);
-    return in ? -d : d;
-  };
-  return s;
+  return fill_shape_with_surface_distance(  // as clumpkit fill does
+      solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); }, path);
 #else
   (void)path;
   std::fprintf(stderr, "fill_bench: built without mesh support\n");

@@ -124,4 +124,19 @@ ClumpTemplate fill_template(const std::string& method, const FillOptions& o, con
   return c;
 }
 
+FillShape fill_shape_with_surface_distance(
+    std::shared_ptr<const RaySolid> solid,
+    std::function<double(const Eigen::Vector3d&)> surface_distance, std::string where) {
+  FillShape s{solid, nullptr, std::move(where)};
+  s.exact_distance = [solid, surface_distance](const Eigen::Vector3d& p) {
+    thread_local IntervalList list;
+    solid->intervals(p, 0, list);
+    bool in = false;
+    for (const Interval& iv : list) in = in || (p.x() > iv.t0 && p.x() < iv.t1);
+    const double d = surface_distance(p);
+    return in ? -d : d;
+  };
+  return s;
+}
+
 }  // namespace clumpkit

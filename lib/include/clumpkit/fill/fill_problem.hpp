@@ -25,6 +25,12 @@ struct FillShape {
   std::string where;  ///< names the shape in messages (file or bundled name)
 };
 
+/// A shape whose exact signed distance is the unsigned distance to its surface, negative where
+/// the solid's x-ray intervals hold the point (a mesh solid: raycast's surface_distance).
+FillShape fill_shape_with_surface_distance(
+    std::shared_ptr<const RaySolid> solid,
+    std::function<double(const Eigen::Vector3d&)> surface_distance, std::string where);
+
 enum class FillMetric { SymmetricDifference, Volume, Inertia };
 const char* to_string(FillMetric m);
 /// "symmetric_difference" | "volume" | "inertia"; throws InputError(field "--metric").
