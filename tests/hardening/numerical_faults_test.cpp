@@ -87,14 +87,38 @@ TEST(NumericalFaults, TimeStepAboveTheStabilityLimitIsRefused) {
   }
 }
 
-TEST(NumericalFaults, TimeStepForcedAboveTheLimitStopsWithADiagnosis) {
-  // The Hertz check passes with a tiny expected impact speed (the override): the run itself
-  // must then catch the instability.
+TEST(NumericalFaults, TimeStepAboveTheDampingLimitIsRefusedAtCreation) {
+  // The Hertz check passes with a tiny expected impact speed (the override); the contact
+  // damping's rate does not depend on it much, and 1e-4 s is above 2/rate.
   WorldSettings s = pills();
   s.time_step = 1e-4;
   s.max_impact_speed = 1e-6;
-  s.walls.push_back({"floor", make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.1, 0.1),
-                     "galvanized_steel", {}, {}});
+  try {
+    (void)World::create(s);
+    FAIL() << "a time step above the damping limit was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "time_step");
+    EXPECT_NE(std::string(e.what()).find("damping"), std::string::npos) << e.what();
+  }
+}
+
+TEST(NumericalFaults, TimeStepForcedAboveTheLimitStopsWithADiagnosis) {
+  // Undamped (elastic) pills: no damping limit. The Hertz check passes with a tiny expected
+  // impact speed (the override): the run itself must then catch the instability.
+  WorldSettings s = pills();
+  s.time_step = 1e-4;
+  s.max_impact_speed = 1e-6;
+  PairContact elastic = PairContact::from(s.materials.interaction("pill", "pill"));
+  elastic.restitution.reset();
+  s.pair_contacts.push_back({"pill", "pill", elastic});
+  PairContact wall = PairContact::from(s.materials.interaction("pill", "galvanized_steel"));
+  wall.restitution.reset();
+  s.pair_contacts.push_back({"pill", "galvanized_steel", wall});
+  s.walls.push_back({"floor",
+                     make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.1, 0.1),
+                     "galvanized_steel",
+                     {},
+                     {}});
   World w = World::create(s);
   EXPECT_FALSE(w.warnings().empty()) << "no warning for a time step far above the Rayleigh time";
   for (int i = 0; i < 5; ++i)
@@ -104,8 +128,7 @@ TEST(NumericalFaults, TimeStepForcedAboveTheLimitStopsWithADiagnosis) {
   ASSERT_FALSE(msg.empty()) << "the unstable run went on; finite state: " << all_finite(w);
   EXPECT_NE(msg.find("time step 0.0001 s"), std::string::npos) << msg;
   EXPECT_TRUE(msg.find("overlap") != std::string::npos ||
-              msg.find("blew up") != std::string::npos ||
-              msg.find("unstable") != std::string::npos)
+              msg.find("blew up") != std::string::npos || msg.find("unstable") != std::string::npos)
       << msg;
 }
 

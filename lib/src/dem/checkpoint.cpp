@@ -116,6 +116,10 @@ void World::save_checkpoint(const std::filesystem::path& path) const {
     o.value(static_cast<std::uint8_t>(wd.motion.rotation ? 1 : 0));
     if (wd.motion.rotation) o.value(*wd.motion.rotation);
   }
+  // Second trailer: the pinch-release tally (older checkpoints load with none).
+  o.str("pinched");
+  o.value(w.pinched_count);
+  o.value(w.pinched_mass);
   write_file_atomic(path, o.buf);
 }
 
@@ -211,7 +215,8 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   if (in.at < data.size()) {
     std::string tag;
     in.str(tag);
-    if (tag != "wall-motions") throw InputError(path.string(), "", "checkpoint is corrupt (trailer)");
+    if (tag != "wall-motions")
+      throw InputError(path.string(), "", "checkpoint is corrupt (trailer)");
     for (WallData& wd : w.walls) {
       WallMotion m;
       in.vec(m.translation.times);
@@ -228,6 +233,17 @@ void World::load_checkpoint(const std::filesystem::path& path) {
     for (size_t k = 0; k < w.walls.size(); ++k) w.settings.walls[k].motion = w.walls[k].motion;
     w.move_walls();
   }
+  if (in.at < data.size()) {
+    std::string tag;
+    in.str(tag);
+    if (tag != "pinched") throw InputError(path.string(), "", "checkpoint is corrupt (trailer)");
+    in.value(w.pinched_count);
+    in.value(w.pinched_mass);
+    if (w.pinched_count < 0 || !(w.pinched_mass >= 0.0))
+      throw InputError(path.string(), "", "checkpoint is corrupt (pinched)");
+  }
+  if (in.at != data.size())
+    throw InputError(path.string(), "", "checkpoint is corrupt (trailing bytes)");
   // The contacts of the saved step are re-detected (detection is a pure function of positions
   // and histories are already restored): nothing else needs them before the next force pass.
   w.pair_contacts.clear();

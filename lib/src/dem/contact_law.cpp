@@ -9,7 +9,7 @@ namespace clumpkit::dem {
 
 namespace {
 // 2 √(5/6), the damping prefactor of the paper's eqs. (3) and (4).
-const double kDampingFactor = 2.0 * std::sqrt(5.0 / 6.0);
+const double kDampingFactor = contact_damping_factor();
 }  // namespace
 
 const char* to_string(RollingModel m) {
@@ -129,8 +129,8 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   double fn = f_hertz;
   if (law.damping) {
     // c δ^(1/4) δ̇ = dΦ/dt, Φ(δ) = (4/5) c δ^(5/4); δ̇ = −vdn.
-    const double c = kDampingFactor * law.beta * std::sqrt(2.0 * law.e_star * std::sqrt(k.r_star) *
-                                                           k.m_star);
+    const double c =
+        kDampingFactor * law.beta * std::sqrt(2.0 * law.e_star * std::sqrt(k.r_star) * k.m_star);
     if (dt > 0.0) {
       const double d_up = delta - 0.5 * dt * vdn;
       const double phi_up = d_up > 0.0 ? 0.8 * c * d_up * std::sqrt(std::sqrt(d_up)) : 0.0;
@@ -158,13 +158,18 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
     const Eigen::Vector3d vt = k.v_rel - vn * n;
     h.shear = project_to_tangent(h.shear, n) + vt * dt;
     Eigen::Vector3d ft = -st * h.shear;
-    if (law.damping) ft -= kDampingFactor * law.beta * std::sqrt(st * k.m_star) * (vd - vdn * n);
+    // As LIGGGHTS 3.8 (tangential_model_history): the spring alone is compared with the
+    // Coulomb limit. Sliding: the spring is cut back to the cone and carries the whole force,
+    // without damping. Sticking: spring plus damping. Putting the damping force into the
+    // rescaled spring instead would store energy no force paid for (a jammed pill then gains
+    // energy every step).
     const double cap = law.mu_s * std::abs(fn_contact);
-    const double ft_norm = ft.norm();
-    if (ft_norm > cap) {
-      // Sliding: the force sits on the Coulomb cone and the spring is rescaled to carry it.
-      ft *= cap / ft_norm;
-      h.shear = st > 0.0 ? Eigen::Vector3d(-ft / st) : Eigen::Vector3d::Zero();
+    const double fs = ft.norm();
+    if (fs > cap) {
+      ft *= cap / fs;
+      h.shear = -ft / st;
+    } else if (law.damping) {
+      ft -= kDampingFactor * law.beta * std::sqrt(st * k.m_star) * (vd - vdn * n);
     }
     out.force += ft;
     out.elastic_energy += 0.5 * st * h.shear.squaredNorm();

@@ -58,6 +58,7 @@ void World::step() {
   w.profile.forces += seconds_since(t0);
   w.kick();
   w.profile.integrate += seconds_since(t0);
+  if (w.settings.pinch_release > 0.0) w.release_pinched(*this);
   w.check_health();
   w.profile.checks += seconds_since(t0);
   ++w.profile.steps;
@@ -476,6 +477,68 @@ void World::Impl::compute_forces(double hdt) {
     }
 }
 
+void World::Impl::release_pinched(World& world) {
+  if (max_overlap_ratio <= settings.pinch_release) return;
+  const int nc = static_cast<int>(c_x.size());
+  const int ns = static_cast<int>(s_r.size());
+  // Both clumps of a pinched pair go: the chain wall → pill → pill → wall is broken either way.
+  std::vector<char> out(nc, 0);
+  std::string first;
+  double first_ratio = 0.0;
+  for (const PairContactData& pc : pair_contacts) {
+    const PairEntry& p = pairs[pc.pair];
+    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
+    if (ratio <= settings.pinch_release) continue;
+    if (ratio > first_ratio) first_ratio = ratio, first = "against another clump";
+    out[s_clump[p.i]] = out[s_clump[p.j]] = 1;
+  }
+  for (int s = 0; s < ns; ++s)
+    for (int k = 0; k < wall_contact_n[s]; ++k) {
+      const double ratio = wall_contacts[s][k].overlap / s_r[s];
+      if (ratio <= settings.pinch_release) continue;
+      if (ratio > first_ratio)
+        first_ratio = ratio, first = "against wall '" + walls[wall_contacts[s][k].wall].name + "'";
+      out[s_clump[s]] = 1;
+    }
+  if (first.empty()) return;
+  // The overlap check then sees the deepest contact left.
+  double left = 0.0;
+  std::string left_what;
+  for (const PairContactData& pc : pair_contacts) {
+    const PairEntry& p = pairs[pc.pair];
+    if (out[s_clump[p.i]] || out[s_clump[p.j]]) continue;
+    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
+    if (ratio > left) {
+      left = ratio;
+      left_what = "clumps " + std::to_string(s_clump[p.i]) + " and " + std::to_string(s_clump[p.j]);
+    }
+  }
+  for (int s = 0; s < ns; ++s) {
+    if (out[s_clump[s]]) continue;
+    for (int k = 0; k < wall_contact_n[s]; ++k)
+      if (wall_contacts[s][k].overlap / s_r[s] > left) {
+        left = wall_contacts[s][k].overlap / s_r[s];
+        left_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
+                    walls[wall_contacts[s][k].wall].name + "'";
+      }
+  }
+  int n = 0;
+  double m = 0.0;
+  for (int c = 0; c < nc; ++c)
+    if (out[c]) ++n, m += types[c_type[c]].mass;
+  if (pinched_count == 0)
+    warnings.push_back("a clump was pinched " + first + " at t = " + fmt_g(time) + " s (overlap " +
+                       fmt_g(100.0 * first_ratio) +
+                       " % of a sphere radius, above the pinch release " +
+                       fmt_g(100.0 * settings.pinch_release) +
+                       " %) and was taken out of the run; later ones are only counted");
+  pinched_count += n;
+  pinched_mass += m;
+  world.remove_clumps([&](int c) { return out[c] != 0; });
+  max_overlap_ratio = left;
+  max_overlap_what = left_what;
+}
+
 void World::Impl::check_health() {
   auto fail = [&](const std::string& what) {
     throw NumericalError("step " + std::to_string(steps) + ", t = " + fmt_g(time) + " s: " + what +
@@ -505,7 +568,8 @@ void World::Impl::check_health() {
       check_ke + std::abs(check_elastic) + std::abs(wall_work) + std::abs(inserted_energy) + floor;
   if (excess > scale)
     fail("energy jumped by " + fmt_g(excess) + " J in " + std::to_string(settings.check_interval) +
-         " steps with no source (kinetic " + fmt_g(check_ke) + " -> " + fmt_g(ke) +
+         " steps with no source (kinetic " + fmt_g(check_ke) + " -> " + fmt_g(ke) + " J, elastic " +
+         fmt_g(check_elastic) + " -> " + fmt_g(elastic) + " J, work by walls " + fmt_g(wall_work) +
          " J): the contact forces are unstable");
   check_energy = e;
   check_ke = ke;

@@ -1,5 +1,6 @@
 #include "clumpkit/dem/time_step.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -44,10 +45,43 @@ Eigen::Quaterniond rotation(std::mt19937_64& g) {
 
 }  // namespace
 
-int wall_contact_multiplicity(const SphereSet& c, double overlap_fraction, int samples) {
-  int best = c.centers.empty() ? 0 : 1;
-  // The body axes first: a clump in its principal frame lies flat on a wall along them (a pill
-  // on its end face puts a whole ring of spheres down at once).
+namespace {
+
+// Largest eigenvalue of M^-1 K for a rigid body (mass m, principal moments I) with unit
+// normal springs along n_k and tangential springs of stiffness kt at the points p_k (body
+// frame, relative to the centre of mass), 1/kg.
+double stiffest_mode(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector3d>& normals, const ClumpInertia& m,
+                     double kt) {
+  Eigen::Matrix<double, 6, 6> k = Eigen::Matrix<double, 6, 6>::Zero();
+  auto add = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& d, double stiffness) {
+    Eigen::Matrix<double, 6, 1> j;
+    j.head<3>() = d;
+    j.tail<3>() = p.cross(d);
+    k += stiffness * j * j.transpose();
+  };
+  for (size_t c = 0; c < points.size(); ++c) {
+    const Eigen::Vector3d& n = normals[c];
+    const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    add(points[c], n, 1.0);
+    add(points[c], t1, kt);
+    add(points[c], t2, kt);
+  }
+  Eigen::Matrix<double, 6, 1> s;  // M^-1/2
+  s.head<3>().setConstant(1.0 / std::sqrt(m.mass));
+  s.tail<3>() = m.inertia.cwiseSqrt().cwiseInverse();
+  const Eigen::Matrix<double, 6, 6> a = s.asDiagonal() * k * s.asDiagonal();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(a, Eigen::EigenvaluesOnly)
+      .eigenvalues()
+      .maxCoeff();
+}
+
+}  // namespace
+
+double wall_contact_mass(const SphereSet& c, const ClumpInertia& m, double tangential_ratio,
+                         double overlap_fraction, int samples) {
+  double lambda = 0.0;
+  std::vector<Eigen::Vector3d> pts, nrm;
   for (int s = -6; s < samples; ++s) {
     const Eigen::Vector3d n =
         s < 0 ? Eigen::Vector3d(Eigen::Vector3d::Unit((s + 6) / 2) * ((s + 6) % 2 ? -1.0 : 1.0))
@@ -55,26 +89,29 @@ int wall_contact_multiplicity(const SphereSet& c, double overlap_fraction, int s
     double h_max = -1e300;
     for (size_t i = 0; i < c.centers.size(); ++i)
       h_max = std::max(h_max, c.centers[i].dot(n) + c.radii[i]);
-    int k = 0;
+    pts.clear(), nrm.clear();
     for (size_t i = 0; i < c.centers.size(); ++i)
-      if (c.centers[i].dot(n) + c.radii[i] >= h_max - overlap_fraction * c.radii[i]) ++k;
-    best = std::max(best, k);
+      if (c.centers[i].dot(n) + c.radii[i] >= h_max - overlap_fraction * c.radii[i]) {
+        pts.push_back(c.centers[i] + c.radii[i] * n);
+        nrm.push_back(n);
+      }
+    lambda = std::max(lambda, stiffest_mode(pts, nrm, m, tangential_ratio));
   }
-  return best;
+  return lambda > 0.0 ? 1.0 / lambda : m.mass;
 }
 
-int clump_contact_multiplicity(const SphereSet& a, const SphereSet& b, double overlap_fraction,
-                               int samples) {
-  if (a.centers.empty() || b.centers.empty()) return 0;
+double clump_contact_mass(const SphereSet& a, const ClumpInertia& ma, const SphereSet& b,
+                          const ClumpInertia& mb, double tangential_ratio, double overlap_fraction,
+                          int samples) {
+  if (a.centers.empty() || b.centers.empty()) return 0.0;
   std::mt19937_64 gen(0x5eed);
   std::vector<Eigen::Vector3d> bc(b.centers.size());
-  int best = 1;
+  std::vector<Eigen::Vector3d> pa, na, pb, nb;
+  double inv = 0.0;
   for (int s = 0; s < samples; ++s) {
     const Eigen::Vector3d n = direction(s, samples);
     const Eigen::Quaterniond q = rotation(gen);
     for (size_t j = 0; j < bc.size(); ++j) bc[j] = q * b.centers[j];
-    // Clump b comes in from far along -n (its centre at d n, d decreasing): pair (i, j) first
-    // touches at the largest root d of |p - d n| = r_i + r_j, p = c_i - c_j.
     double first = -1e300, r_small = 1e300;
     for (size_t i = 0; i < a.centers.size(); ++i)
       for (size_t j = 0; j < bc.size(); ++j) {
@@ -85,15 +122,26 @@ int clump_contact_multiplicity(const SphereSet& a, const SphereSet& b, double ov
         r_small = std::min({r_small, a.radii[i], b.radii[j]});
       }
     const double d = first - overlap_fraction * r_small;
-    int k = 0;
+    pa.clear(), na.clear(), pb.clear(), nb.clear();
+    const Eigen::Quaterniond qi = q.inverse();
     for (size_t i = 0; i < a.centers.size(); ++i)
       for (size_t j = 0; j < bc.size(); ++j) {
+        const Eigen::Vector3d bj = bc[j] + d * n;  // b's sphere, a's frame
+        const Eigen::Vector3d ab = bj - a.centers[i];
         const double rr = a.radii[i] + b.radii[j];
-        if ((a.centers[i] - bc[j] - d * n).squaredNorm() < rr * rr) ++k;
+        if (ab.squaredNorm() >= rr * rr || ab.squaredNorm() == 0.0) continue;
+        const Eigen::Vector3d u = ab.normalized();  // from a's sphere towards b's
+        pa.push_back(a.centers[i] + a.radii[i] * u);
+        na.push_back(u);
+        // In b's body frame: its sphere centre, and the normal pointing back at a.
+        pb.push_back(b.centers[j] - b.radii[j] * (qi * u));
+        nb.push_back(-(qi * u));
       }
-    best = std::max(best, k);
+    if (pa.empty()) continue;
+    inv = std::max(inv, stiffest_mode(pa, na, ma, tangential_ratio) +
+                            stiffest_mode(pb, nb, mb, tangential_ratio));
   }
-  return best;
+  return inv > 0.0 ? 1.0 / inv : ma.mass * mb.mass / (ma.mass + mb.mass);
 }
 
 }  // namespace clumpkit::dem

@@ -243,6 +243,9 @@ World World::create(WorldSettings s) {
   if (!(s.max_impact_speed > 0.0)) throw InputError(where, "max_impact_speed", "must be > 0 m/s");
   if (!(s.max_speed > 0.0)) throw InputError(where, "max_speed", "must be > 0 m/s");
   if (s.check_interval < 1) throw InputError(where, "check_interval", "must be >= 1");
+  if (!(s.pinch_release >= 0.0 && s.pinch_release < 0.5))
+    throw InputError(where, "pinch_release",
+                     "must be in [0, 0.5) (a fraction of a sphere radius; 0 = off)");
   if (!s.gravity.allFinite()) throw InputError(where, "gravity", "must be finite");
   if (smallest_type >= 0) {
     const Material& m = w.materials[w.types[smallest_type].material];
@@ -253,46 +256,77 @@ World World::create(WorldSettings s) {
       w.warnings.push_back("time step " + fmt_g(w.dt) + " s is " + fmt_g(100.0 * frac) +
                            " % of the Rayleigh time " + fmt_g(tr) +
                            " s of the smallest sphere (above 40 %: expect instability)");
-    // Hertz contact time at the largest expected impact speed, for every pair that can touch.
-    // A clump impact loads every sphere pair in contact at once: N Hertz springs in parallel
-    // last N^(-2/5) as long as one (time_step.hpp).
-    double tc_min = std::numeric_limits<double>::infinity();
-    std::string tc_what;
+    // Two limits for every pair that can touch, at the largest expected impact speed
+    // (time_step.hpp). Stiffness: the Hertz impact of the clump's equivalent mass for its
+    // stiffest contact mode (normal springs; several spheres at once, rocking) spans 10 steps.
+    // Damping: the contact damping is sized with the clumps' masses (as in LIGGGHTS) but acts
+    // on contact points that can be far lighter (a pill turns easily about its axis), so its
+    // rate Γ = c/m_eq (normal and tangential dashpots) must stay below 1/step: explicit damping
+    // grows without bound above 2, and a jammed pill was seen to blow up at Γ dt = 1.35.
+    constexpr double kStepsPerImpact = 10.0, kDampingLimit = 1.0;
+    double tc_min = std::numeric_limits<double>::infinity(), gamma_max = 0.0;
+    std::string tc_what, gamma_what;
     std::vector<SphereSet> shapes;
-    for (const auto& t : w.types) shapes.push_back({t.offsets, t.radii});
+    std::vector<ClumpInertia> inertias;
+    for (const auto& t : w.types) {
+      shapes.push_back({t.offsets, t.radii});
+      inertias.push_back({t.mass, t.inertia});
+    }
+    auto percent = [](double part, double whole) {
+      return fmt_g(std::round(100.0 * part / whole));
+    };
+    // One pair of contact modes: normal-spring equivalent mass mn, dashpot equivalent mass mc.
+    auto consider = [&](const ResolvedContact& law, double r_star, double m_star, double mn,
+                        double mc, const std::string& what) {
+      const double v = s.max_impact_speed;
+      const double tc = hertz_contact_time(law.e_star, r_star, mn, v);
+      if (tc < tc_min)
+        tc_min = tc,
+        tc_what = what + " (stiffest contact mode: " + percent(mn, m_star) + " % of the mass)";
+      if (!law.damping) return;
+      const double stiffness =
+          2.0 * law.e_star * std::sqrt(r_star * hertz_max_overlap(law.e_star, r_star, mn, v));
+      const double gamma = contact_damping_factor() * law.beta * std::sqrt(stiffness * m_star) / mc;
+      if (gamma > gamma_max)
+        gamma_max = gamma,
+        gamma_what = what + " (dashpots on " + percent(mc, m_star) + " % of the mass)";
+    };
     for (size_t t = 0; t < w.types.size(); ++t) {
-      const double wall_factor = std::pow(wall_contact_multiplicity(shapes[t]), -0.4);
       for (size_t u = t; u < w.types.size(); ++u) {
         const auto& law = w.law(w.types[t].material, w.types[u].material);
         const double mst = w.types[t].mass * w.types[u].mass / (w.types[t].mass + w.types[u].mass);
-        const int n = clump_contact_multiplicity(shapes[t], shapes[u]);
+        const double dash_t = std::sqrt(4.0 * law.g_star / law.e_star);  // c_t / c_n
+        const double mn = clump_contact_mass(shapes[t], inertias[t], shapes[u], inertias[u], 0.0);
+        const double mc =
+            clump_contact_mass(shapes[t], inertias[t], shapes[u], inertias[u], dash_t);
         for (double r : w.types[t].radii)
-          for (double r2 : w.types[u].radii) {
-            const double tc = hertz_contact_time(law.e_star, r * r2 / (r + r2), mst,
-                                                 s.max_impact_speed) *
-                              std::pow(n, -0.4);
-            if (tc < tc_min)
-              tc_min = tc, tc_what = "clump-clump (" + std::to_string(n) + " sphere pairs)";
-          }
+          for (double r2 : w.types[u].radii)
+            consider(law, r * r2 / (r + r2), mst, mn, mc, "clump-clump");
       }
-      for (double r : w.types[t].radii)
-        for (const auto& wd : w.walls) {
-          const auto& law = w.law(w.types[t].material, wd.material);
-          const double tc =
-              hertz_contact_time(law.e_star, r, w.types[t].mass, s.max_impact_speed) * wall_factor;
-          if (tc < tc_min) tc_min = tc, tc_what = "clump-wall '" + wd.name + "'";
-        }
+      for (const auto& wd : w.walls) {
+        const auto& law = w.law(w.types[t].material, wd.material);
+        const double dash_t = std::sqrt(4.0 * law.g_star / law.e_star);
+        const double mn = wall_contact_mass(shapes[t], inertias[t], 0.0);
+        const double mc = wall_contact_mass(shapes[t], inertias[t], dash_t);
+        for (double r : w.types[t].radii)
+          consider(law, r, w.types[t].mass, mn, mc, "clump-wall '" + wd.name + "'");
+      }
     }
-    // The default time step honours both limits: a fraction of the Rayleigh time, and at
-    // least 10 steps per Hertz impact at the largest expected speed. The second binds for
-    // clumps of few large spheres (their mass is close to one sphere's, so impacts are short).
-    if (s.time_step <= 0.0 && tc_min / w.dt < 10.0) {
+    // The default time step honours all three limits: a fraction of the Rayleigh time, 10 steps
+    // per impact, and the damping rate.
+    if (s.time_step <= 0.0) {
       const double was = w.dt;
-      w.dt = tc_min / 10.0;
-      w.warnings.push_back("time step " + fmt_g(w.dt) + " s instead of " +
-                           fmt_g(s.rayleigh_fraction) + " x the Rayleigh time (" + fmt_g(was) +
-                           " s): a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) +
-                           " m/s lasts " + fmt_g(tc_min) + " s, which needs 10 steps");
+      if (tc_min / w.dt < kStepsPerImpact) w.dt = tc_min / kStepsPerImpact;
+      if (gamma_max * w.dt > kDampingLimit) w.dt = kDampingLimit / gamma_max;
+      if (w.dt < was)
+        w.warnings.push_back(
+            "time step " + fmt_g(w.dt) + " s instead of " + fmt_g(s.rayleigh_fraction) +
+            " x the Rayleigh time (" + fmt_g(was) + " s): " +
+            (w.dt * gamma_max >= kDampingLimit * (1.0 - 1e-12)
+                 ? "the contact damping of a " + gamma_what + " acts at a rate of " +
+                       fmt_g(gamma_max) + " /s, which needs steps of at most 1/rate"
+                 : "a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) + " m/s lasts " +
+                       fmt_g(tc_min) + " s, which needs 10 steps"));
     }
     const double per = tc_min / w.dt;
     if (per < 4.0)
@@ -301,9 +335,19 @@ World World::create(WorldSettings s) {
                            tc_what + " impact at " + fmt_g(s.max_impact_speed) + " m/s lasts " +
                            fmt_g(tc_min) + " s, only " + fmt_g(per) +
                            " steps (at least 4 needed, 10 advised)");
-    if (per < 10.0)
+    if (gamma_max * w.dt >= 2.0)
+      throw InputError(where, "time_step",
+                       "time step " + fmt_g(w.dt) + " s is above the stability limit of the " +
+                           "contact damping: a " + gamma_what + " damps at a rate of " +
+                           fmt_g(gamma_max) + " /s, and explicit damping grows without bound " +
+                           "above 2/rate = " + fmt_g(2.0 / gamma_max) + " s (1/rate advised)");
+    if (per < kStepsPerImpact)
       w.warnings.push_back("a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) +
                            " m/s lasts only " + fmt_g(per) + " steps (10 or more advised)");
+    if (gamma_max * w.dt > kDampingLimit)
+      w.warnings.push_back("the contact damping of a " + gamma_what + " acts at a rate of " +
+                           fmt_g(gamma_max) + " /s: the time step " + fmt_g(w.dt) +
+                           " s is above 1/rate (instability seen above 1.35/rate)");
     w.skin = s.skin > 0.0 ? s.skin : 0.3 * w.r_min;
     w.cell = 2.0 * w.r_max + w.skin;
   } else {
@@ -495,6 +539,12 @@ double World::dt() const {
 }
 const std::vector<std::string>& World::warnings() const {
   return impl_->warnings;
+}
+int World::pinched_count() const {
+  return impl_->pinched_count;
+}
+double World::pinched_mass() const {
+  return impl_->pinched_mass;
 }
 const Profile& World::profile() const {
   return impl_->profile;

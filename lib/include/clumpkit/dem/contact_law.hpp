@@ -122,6 +122,11 @@ struct ContactForce {
 
 /// Evaluates the law for one contact over a step of `dt`, updating the history springs.
 ///
+/// The paper's damping prefactor 2√(5/6): c_n = 2√(5/6) β √(S_n m*), eq. (3).
+inline double contact_damping_factor() {
+  return 1.8257418583505538;
+}
+
 /// The normal damping force of eq. (3), c δ^(1/4) δ̇ with c = 2√(5/6) β √(2 Y* √R* m*), is the
 /// time derivative of Φ(δ) = (4/5) c δ^(5/4). With dt > 0 it is applied as the impulse
 /// Φ(δ(t + dt/2)) − Φ(δ(t − dt/2)) over the step's window, divided by dt: the upper end is

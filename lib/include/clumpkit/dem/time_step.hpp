@@ -21,18 +21,36 @@ struct SphereSet {
   std::vector<double> radii;
 };
 
-/// How many spheres of a clump can press on a flat wall at once: over `samples` approach
-/// directions, the spheres within `overlap_fraction` of their radius of the first to touch.
-/// An impact then loads that many Hertz springs in parallel, so it lasts t_c(one sphere) times
-/// N^(-2/5). Clumps of a few heavily overlapping spheres (the paper's A4, B4, C2) have N close to
-/// their sphere count and a mass close to one sphere's: their impacts are the shortest.
-int wall_contact_multiplicity(const SphereSet& clump, double overlap_fraction = 0.05,
-                              int samples = 256);
+/// A clump's mass properties in its principal frame (centres in `SphereSet` relative to the
+/// centre of mass, principal axes as coordinate axes).
+struct ClumpInertia {
+  double mass = 0.0;                                  ///< kg
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  ///< principal moments, kg m²
+};
 
-/// The same for two clumps: over `samples` approach directions and relative orientations
-/// (deterministic), the most sphere pairs in contact when clump b has moved `overlap_fraction`
-/// of the smaller radius past its first touch of clump a.
-int clump_contact_multiplicity(const SphereSet& a, const SphereSet& b,
-                               double overlap_fraction = 0.05, int samples = 256);
+/// Equivalent mass of the stiffest contact mode of a clump pressed on a flat wall, kg.
+/// Over `samples` approach directions (and the body axes), the spheres within `overlap_fraction`
+/// of their radius of the first touch carry unit normal springs and tangential springs of
+/// stiffness `tangential_ratio` (Mindlin: 8G*/(2E*)), acting at their contact points on the
+/// rigid clump. The largest eigenvalue λ of M^-1 K (M = diag(m, m, m, I)) is the squared
+/// frequency of the fastest mode per unit spring: 1/λ is the mass a single Hertz spring would
+/// need to ring as fast. It is m/N for N spheres touching together (a Hertz impact on N
+/// springs in parallel lasts N^(-2/5) as long), and smaller again when the contacts can rock or
+/// twist the clump about its centre: a pill flat on its face rocks about √2 times faster than it
+/// bounces. The default time step makes a Hertz impact of this mass last 10 steps; with half of
+/// that the explicit contact damping of a pill jammed among neighbours was seen to grow without
+/// bound (docs/dem.md).
+double wall_contact_mass(const SphereSet& clump, const ClumpInertia& m,
+                         double tangential_ratio = 0.8, double overlap_fraction = 0.05,
+                         int samples = 256);
+
+/// The same for two clumps pressed together: over `samples` approach directions and relative
+/// orientations (deterministic), the sphere pairs in contact when clump b has moved
+/// `overlap_fraction` of the smaller radius past its first touch of clump a; 1/m_eq = λ_a + λ_b,
+/// each body's stiffest mode under the contacts of the pair (a bound: the two modes need not
+/// coincide), kg.
+double clump_contact_mass(const SphereSet& a, const ClumpInertia& ma, const SphereSet& b,
+                          const ClumpInertia& mb, double tangential_ratio = 0.8,
+                          double overlap_fraction = 0.05, int samples = 256);
 
 }  // namespace clumpkit::dem

@@ -66,6 +66,13 @@ struct WorldSettings {
   /// Blow-up detection: checked every `check_interval` steps.
   int check_interval = 50;
   double max_speed = 50.0;  ///< m/s; a clump faster than this is a blow-up
+  /// Pinch release, a fraction of a sphere radius in [0, 0.5); 0 = off. A prescribed wall
+  /// has unlimited force: a pill caught between a moving wall and a fixed one (a vane tip
+  /// passing the throat edge, a scraper at the rim) is squeezed without limit, and the run
+  /// would stop at the 50 % overlap check. With a release set, a clump whose overlap with a
+  /// wall exceeds it is taken out of the run instead (a real pill would break or be pushed
+  /// aside) and counted by World::pinched_count() / pinched_mass(); the first one is a warning.
+  double pinch_release = 0.0;
 };
 
 /// One wall's kinematic state and the load it carries (from the last force evaluation).
@@ -109,6 +116,9 @@ class World {
   double dt() const;
   /// Warnings raised at creation or while running (time step, factories), in order.
   const std::vector<std::string>& warnings() const;
+  /// Clumps taken out by the pinch release (WorldSettings::pinch_release) and their mass, kg.
+  int pinched_count() const;
+  double pinched_mass() const;
   const Profile& profile() const;
   Profile& profile();
   const WorldSettings& settings() const;
