@@ -262,7 +262,7 @@ World World::create(WorldSettings s) {
     // Damping: the contact damping is sized with the clumps' masses (as in LIGGGHTS) but acts
     // on contact points that can be far lighter (a pill turns easily about its axis), so its
     // rate Γ = c/m_eq (normal and tangential dashpots) must stay below 1/step: explicit damping
-    // grows without bound above 2, and a jammed pill was seen to blow up at Γ dt = 1.35.
+    // grows without bound above 2, and a jammed pill was seen to blow up at Γ dt = 1.98.
     constexpr double kStepsPerImpact = 10.0, kDampingLimit = 1.0;
     double tc_min = std::numeric_limits<double>::infinity(), gamma_max = 0.0;
     std::string tc_what, gamma_what;
@@ -347,7 +347,7 @@ World World::create(WorldSettings s) {
     if (gamma_max * w.dt > kDampingLimit)
       w.warnings.push_back("the contact damping of a " + gamma_what + " acts at a rate of " +
                            fmt_g(gamma_max) + " /s: the time step " + fmt_g(w.dt) +
-                           " s is above 1/rate (instability seen above 1.35/rate)");
+                           " s is above 1/rate (a jammed pill was seen to blow up at 1.98/rate)");
     w.skin = s.skin > 0.0 ? s.skin : 0.3 * w.r_min;
     w.cell = 2.0 * w.r_max + w.skin;
   } else {
