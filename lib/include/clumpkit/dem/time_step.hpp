@@ -32,14 +32,15 @@ struct ClumpInertia {
 /// Over `samples` approach directions (and the body axes), the spheres within `overlap_fraction`
 /// of their radius of the first touch carry unit normal springs and tangential springs of
 /// weight `tangential_ratio` (0: normal springs only, for the stiffness limit; √(k_t/k_n) for the
-/// dashpots of the damping limit), acting at their contact points on the rigid clump. The largest eigenvalue λ of M^-1 K (M = diag(m, m, m, I)) is the squared
-/// frequency of the fastest mode per unit spring: 1/λ is the mass a single Hertz spring would
-/// need to ring as fast. It is m/N for N spheres touching together (a Hertz impact on N
-/// springs in parallel lasts N^(-2/5) as long), and smaller again when the contacts can rock or
-/// twist the clump about its centre: a pill flat on its face rocks about √2 times faster than it
-/// bounces. The default time step makes a Hertz impact of this mass last 10 steps and keeps the
-/// contact damping's rate on the dashpot equivalent mass below 1/step (World::create,
-/// docs/dem.md): above about 2/step the explicit damping of a jammed pill grows without bound.
+/// dashpots of the damping limit), acting at their contact points on the rigid clump. The largest
+/// eigenvalue λ of M^-1 K (M = diag(m, m, m, I)) is the squared frequency of the fastest mode per
+/// unit spring: 1/λ is the mass a single Hertz spring would need to ring as fast. It is m/N for N
+/// spheres touching together (a Hertz impact on N springs in parallel lasts N^(-2/5) as long), and
+/// smaller again when the contacts can rock or twist the clump about its centre: a pill flat on its
+/// face rocks about √2 times faster than it bounces. The default time step makes a Hertz impact of
+/// this mass last 10 steps and keeps the contact damping's rate on the dashpot equivalent mass
+/// below 1/step (World::create, docs/dem.md): above about 2/step the explicit damping of a jammed
+/// pill grows without bound.
 double wall_contact_mass(const SphereSet& clump, const ClumpInertia& m,
                          double tangential_ratio = 0.8, double overlap_fraction = 0.05,
                          int samples = 256);
