@@ -1,5 +1,6 @@
 // clumpkit fill SHAPE --method paper --spheres N -o OUT.json
-// clumpkit fill SHAPE|MESH|TEST_SHAPE --method edt|optimal (--spheres N | --max-error E) -o OUT.json
+// clumpkit fill SHAPE|MESH|TEST_SHAPE --method edt|optimal (--spheres N | --max-error E) -o
+// OUT.json
 #include <fmt/format.h>
 
 #include <iostream>
@@ -72,8 +73,11 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   }
   const ShapeSpec spec = load_shape(resolve_shape(a.shape));
   density = spec.density;
-  source = {{"shape", spec.name}, {"file", spec.path.string()}, {"density", spec.density},
-            {"material", spec.material}, {"mass_fraction", spec.mass_fraction}};
+  source = {{"shape", spec.name},
+            {"file", spec.path.string()},
+            {"density", spec.density},
+            {"material", spec.material},
+            {"mass_fraction", spec.mass_fraction}};
   if (spec.kind == ShapeSpec::Kind::Cylinder) {
     auto cyl = std::make_shared<Cylinder>(spec.diameter, spec.height);
     source["kind"] = "cylinder";
@@ -143,17 +147,19 @@ int run_general(const FillArgs& a) {
 
 Command setup(CLI::App& parent) {
   auto args = std::make_shared<FillArgs>();
-  CLI::App* c = parent.add_subcommand("fill", "Fill a shape with a sphere clump and write a "
-                                              "clumpkit-clump/1 template (JSON, SI units)");
+  CLI::App* c = parent.add_subcommand("fill",
+                                      "Fill a shape with a sphere clump and write a "
+                                      "clumpkit-clump/1 template (JSON, SI units)");
   c->add_option("SHAPE", args->shape, "Shape file (shapes/*.toml) or bundled name (pill_A)")
       ->required();
   c->add_option("--method", args->method,
                 "Fill method: paper (tangency rules, cylinders), edt (greedy largest inscribed "
                 "sphere, baseline), optimal (optimiser; any shape or mesh)")
       ->check(CLI::IsMember({"paper", "edt", "optimal"}));
-  c->add_option("--spheres", args->spheres, "Number of spheres (paper presets: flat 4/12/20, "
-                                            "tall 2/12/18; edt/optimal: any, or the cap with "
-                                            "--max-error)");
+  c->add_option("--spheres", args->spheres,
+                "Number of spheres (paper presets: flat 4/12/20, "
+                "tall 2/12/18; edt/optimal: any, or the cap with "
+                "--max-error)");
   c->add_option("--max-error", args->max_error,
                 "edt/optimal: stop at this relative error on --metric (e.g. 0.05); exit 3 and "
                 "the best found if unreachable");
@@ -161,7 +167,8 @@ Command setup(CLI::App& parent) {
                 "edt/optimal: error metric of --max-error: symmetric_difference (|S xor U|/|S|), "
                 "volume, inertia (principal moments)")
       ->check(CLI::IsMember({"symmetric_difference", "volume", "inertia"}));
-  c->add_option("--min-radius", args->min_radius, "edt/optimal: smallest sphere radius (\"0.2 mm\")");
+  c->add_option("--min-radius", args->min_radius,
+                "edt/optimal: smallest sphere radius (\"0.2 mm\")");
   c->add_option("--tolerance", args->tolerance,
                 "edt/optimal: how far a sphere may leave the shape (\"0.05 mm\"; default 1 % of "
                 "the volume-equivalent diameter)");
@@ -210,9 +217,9 @@ Command setup(CLI::App& parent) {
             }
 #endif
             save_clump(clump, args->out);
-            std::cout << fmt::format("{}: {} spheres, union volume {:.4g} mm^3, mass {:.4g} g -> {}\n",
-                                     clump.name, clump.spheres.size(), clump.mass.volume * 1e9,
-                                     clump.mass.mass * 1e3, args->out);
+            std::cout << fmt::format(
+                "{}: {} spheres, union volume {:.4g} mm^3, mass {:.4g} g -> {}\n", clump.name,
+                clump.spheres.size(), clump.mass.volume * 1e9, clump.mass.mass * 1e3, args->out);
             return 0;
           }};
 }

@@ -10,8 +10,8 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <iostream>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <sstream>
 
@@ -78,9 +78,8 @@ void write_svg(const std::string& path, const std::vector<std::string>& shapes, 
     };
     o << fmt::format("<text x='{}' y='{}' font-weight='bold'>{}</text>\n", ox + ml, oy + 14,
                      shapes[k]);
-    o << fmt::format(
-        "<rect x='{}' y='{}' width='{}' height='{}' fill='none' stroke='#888'/>\n", ox + ml,
-        oy + mt, w, h);
+    o << fmt::format("<rect x='{}' y='{}' width='{}' height='{}' fill='none' stroke='#888'/>\n",
+                     ox + ml, oy + mt, w, h);
     for (double e : {0.01, 0.03, 0.1, 0.3, 1.0})
       o << fmt::format("<text x='{}' y='{:.1f}' text-anchor='end'>{}</text>\n", ox + ml - 3,
                        Y(e) + 3, e);
@@ -93,23 +92,23 @@ void write_svg(const std::string& path, const std::vector<std::string>& shapes, 
       std::string poly;
       for (const auto& [c, e] : pts) poly += fmt::format("{:.1f},{:.1f} ", X(c), Y(e));
       const std::string col = colour.count(method) ? colour.at(method) : "#000";
-      o << fmt::format("<polyline points='{}' fill='none' stroke='{}' stroke-width='1.5'/>\n",
-                       poly, col);
+      o << fmt::format("<polyline points='{}' fill='none' stroke='{}' stroke-width='1.5'/>\n", poly,
+                       col);
       for (const auto& [c, e] : pts)
-        o << fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='2.5' fill='{}'/>\n", X(c), Y(e),
-                         col);
+        o << fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='2.5' fill='{}'/>\n", X(c), Y(e), col);
     }
   }
   int lx = 10;
   for (const auto& [m, col] : colour) {
-    o << fmt::format("<rect x='{}' y='{}' width='12' height='4' fill='{}'/>", lx,
-                     rows * ph + 12, col)
+    o << fmt::format("<rect x='{}' y='{}' width='12' height='4' fill='{}'/>", lx, rows * ph + 12,
+                     col)
       << fmt::format("<text x='{}' y='{}'>{}</text>\n", lx + 16, rows * ph + 17, m);
     lx += 80;
   }
-  o << fmt::format("<text x='{}' y='{}'>symmetric-difference error |S xor U|/|S| (log) against "
-                   "sphere count (log), measured on 10^6 independent rays</text>\n",
-                   lx + 10, rows * ph + 17)
+  o << fmt::format(
+           "<text x='{}' y='{}'>symmetric-difference error |S xor U|/|S| (log) against "
+           "sphere count (log), measured on 10^6 independent rays</text>\n",
+           lx + 10, rows * ph + 17)
     << "</svg>\n";
 }
 }  // namespace

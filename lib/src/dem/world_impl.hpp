@@ -153,8 +153,8 @@ struct World::Impl {
   double check_energy = 0.0;  // KE + PE + elastic at the last check
   double check_ke = 0.0;
   double check_elastic = 0.0;
-  int pinched_count = 0;      // clumps taken out by the pinch release
-  double pinched_mass = 0.0;  // kg
+  int pinched_count = 0;         // clumps taken out by the pinch release
+  double pinched_mass = 0.0;     // kg
   double wall_work = 0.0;        // J done by walls on particles since the last check
   double inserted_energy = 0.0;  // J brought in by factories since the last check
   bool check_initialised = false;
