@@ -61,7 +61,7 @@ class Optimiser {
   }
 
   FillResult run() {
-    const auto t0 = std::chrono::steady_clock::now();
+    t0_ = std::chrono::steady_clock::now();
     Spheres s;
     FillResult res;
     res.tolerance = ctx_.tolerance;
@@ -75,21 +75,29 @@ class Optimiser {
     res.spheres = s;
     res.error = err.metric;
     res.target_reached = o_.max_error <= 0 || err.metric <= o_.max_error;
-    res.report = {
-        {"algorithm",
-         "lazy-greedy coverage seeding, joint centre/radius descent on the "
-         "ray-sampled symmetric difference, swap moves, pruning"},
-        {"grid_cell", ctx_.grid.h},
-        {"candidates", cand_.size()},
-        {"objective_evaluations", evaluations_},
-        {"descent_iterations", iterations_},
-        {"symmetric_difference", err.symmetric_difference},
-        {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},
-        {"history", history_}};
+    res.report = {{"algorithm",
+                   "lazy-greedy coverage seeding, joint centre/radius descent on the "
+                   "ray-sampled symmetric difference, swap moves, pruning"},
+                  {"grid_cell", ctx_.grid.h},
+                  {"candidates", cand_.size()},
+                  {"objective_evaluations", evaluations_},
+                  {"descent_iterations", iterations_},
+                  {"symmetric_difference", err.symmetric_difference},
+                  {"seconds", seconds()},
+                  {"history", history_}};
     return res;
   }
 
  private:
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+  }
+  // One line of the report's history, stamped with the time since the start (s).
+  void note(nlohmann::json entry) {
+    entry["seconds"] = seconds();
+    history_.push_back(std::move(entry));
+  }
+
   double objective(const Spheres& s) {
     ++evaluations_;
     return ctx_.objective(s);
@@ -329,7 +337,12 @@ class Optimiser {
   // axes and along its own descent direction (radius kept, or grown to the largest admissible),
   // the radius alone up and down. Moves are scored incrementally (only the rays the sphere
   // crosses before or after) and taken when the sampled symmetric difference falls.
-  double polish(Spheres& s, int sweeps) {
+  //
+  // All but the last `exact_sweeps` sweeps score a large sphere on an evenly spread subset of its
+  // rays (at most kPolishLines lines; a different subset each sweep), so a sweep costs about the
+  // same whatever the radii; the last sweeps use every ray.
+  static constexpr int kPolishLines = 3000;
+  double polish(Spheres& s, int sweeps, int exact_sweeps) {
     const int n = static_cast<int>(s.size());
     double f = objective(s);
     if (n == 0) return f;
@@ -338,6 +351,8 @@ class Optimiser {
     std::vector<double> delta(n);
     for (int i = 0; i < n; ++i) delta[i] = 0.1 * s[i].radius;
     detail::RayCache::Local L;
+    Spheres trials;
+    std::vector<double> values;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       ++iterations_;
       const auto g = gradient(s);
@@ -348,36 +363,30 @@ class Optimiser {
         const Sphere cur = s[i];
         const double rho_cur = ctx_.max_radius(cur.center);
         // Every trial sphere lies within ball(c, r + 2 delta) (radii grow by at most delta).
-        ctx_.cache->local(s, i, cur.radius + 2.0 * delta[i] + 1e-9 * ctx_.size, L);
+        const bool exact = sweep >= sweeps - exact_sweeps;
+        ctx_.cache->local(s, i, cur.radius + 2.0 * delta[i] + 1e-9 * ctx_.size, L,
+                          exact ? 0 : kPolishLines, sweep * 7 + i);
         ++evaluations_;
         const double base = ctx_.cache->local_value(L, cur);
         Eigen::Vector3d dc = g[i].c;
         if (cur.radius >= rho_cur - 1e-6 * ctx_.size && g[i].r < 0)
           dc -= g[i].r * ctx_.distance_gradient(cur.center);
-        double best_d = -1e-9 * vs;
-        Sphere best = cur;
-        auto trial = [&](const Sphere& t) {
-          const double d = ctx_.cache->local_value(L, t) - base;
-          if (d < best_d) {
-            best_d = d;
-            best = t;
-          }
-        };
+        // Trials are cheap here: the descent direction at three step lengths, the six axis
+        // directions, and the radius alone. They are scored in parallel and compared in order.
+        trials.clear();
         auto shift = [&](const Eigen::Vector3d& u, double len) {
           Sphere t;
           t.center = cur.center + len * u;
           const double rho = ctx_.max_radius(t.center);
           if (rho < rmin) return;
           t.radius = std::max(rmin, std::min(cur.radius, rho));
-          trial(t);
+          trials.push_back(t);
           const double grown = std::min(rho, cur.radius + len);
           if (grown > t.radius * (1 + 1e-9)) {
             t.radius = grown;
-            trial(t);
+            trials.push_back(t);
           }
         };
-        // Trials are cheap here: the descent direction at three step lengths, the six axis
-        // directions, and the radius alone.
         if (dc.norm() > 0)
           for (const double k : {1.0, 0.5, 0.25}) shift(-dc.normalized(), k * delta[i]);
         for (int a = 0; a < 3; ++a)
@@ -385,8 +394,19 @@ class Optimiser {
         for (const double dr : {delta[i], -delta[i], 0.3 * delta[i], -0.3 * delta[i]}) {
           Sphere t = cur;
           t.radius = std::clamp(cur.radius + dr, rmin, std::max(rmin, rho_cur));
-          if (t.radius != cur.radius) trial(t);
+          if (t.radius != cur.radius) trials.push_back(t);
         }
+        const int nt = static_cast<int>(trials.size());
+        values.resize(nt);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+        for (int k = 0; k < nt; ++k) values[k] = ctx_.cache->local_value(L, trials[k]);
+        double best_d = -1e-9 * vs;
+        Sphere best = cur;
+        for (int k = 0; k < nt; ++k)
+          if (values[k] - base < best_d) {
+            best_d = values[k] - base;
+            best = trials[k];
+          }
         if (best_d < -1e-9 * vs) {
           s[i] = best;
           f += best_d / vs;
@@ -421,8 +441,8 @@ class Optimiser {
     };
     std::vector<std::pair<double, Spheres>> starts;
     Spheres capped;  // the r_eq-capped seeding, shared by its plain and Lloyd starts
-    for (const Start st : {Start{inf, false}, Start{1.25 * r_eq, false}, Start{r_eq, false},
-                           Start{r_eq, true}}) {
+    for (const Start st :
+         {Start{inf, false}, Start{1.25 * r_eq, false}, Start{r_eq, false}, Start{r_eq, true}}) {
       cap_ = st.cap;
       step_ = 0.01 * ctx_.size;
       Spheres t;
@@ -435,24 +455,30 @@ class Optimiser {
         if (st.cap == r_eq) capped = t;
       }
       const double ft = refine(t, 15);
-      history_.push_back({{"stage", "start"},
-                          {"radius_cap", std::isinf(st.cap) ? -1.0 : st.cap},
-                          {"lloyd", st.lloyd},
-                          {"spheres", t.size()},
-                          {"objective", ft}});
+      note({{"stage", "start"},
+            {"radius_cap", std::isinf(st.cap) ? -1.0 : st.cap},
+            {"lloyd", st.lloyd},
+            {"spheres", t.size()},
+            {"objective", ft}});
       starts.emplace_back(ft, std::move(t));
     }
     cap_ = inf;
-    // The two best starts are descended and polished in full; the better goes on.
+    // The two best starts are descended and polished in full (the second only if its descent
+    // ends within twice the first's objective: polish rarely gains more); the better goes on.
     std::stable_sort(starts.begin(), starts.end(),
                      [](const auto& x, const auto& y) { return x.first < y.first; });
-    double f = inf;
+    double f = inf, first_descent = inf;
     for (size_t k = 0; k < std::min<size_t>(2, starts.size()); ++k) {
       Spheres t = std::move(starts[k].second);
       step_ = 0.01 * ctx_.size;
-      refine(t, 30);
-      const double ft = polish(t, 12);
-      history_.push_back({{"stage", "descent+polish"}, {"spheres", t.size()}, {"objective", ft}});
+      const double fd = refine(t, 30);
+      if (k == 0) first_descent = fd;
+      if (k > 0 && fd > 2.0 * first_descent) {
+        note({{"stage", "descent"}, {"spheres", t.size()}, {"objective", fd}});
+        break;
+      }
+      const double ft = polish(t, 12, 0);
+      note({{"stage", "descent+polish"}, {"spheres", t.size()}, {"objective", ft}});
       if (ft < f) {
         f = ft;
         s = std::move(t);
@@ -468,11 +494,11 @@ class Optimiser {
       if (seed(t, 1) == 0) break;
       step_ = 0.01 * ctx_.size;
       refine(t, 12);
-      const double ft = polish(t, 8);
+      const double ft = polish(t, 8, 0);
       if (ft < f - 1e-6 * f) {
         s = std::move(t);
         f = ft;
-        history_.push_back({{"stage", "swap"}, {"spheres", s.size()}, {"objective", f}});
+        note({{"stage", "swap"}, {"spheres", s.size()}, {"objective", f}});
       } else {
         break;
       }
@@ -482,8 +508,8 @@ class Optimiser {
       seed(s, n - static_cast<int>(s.size()));
       refine(s, 20);
     }
-    f = polish(s, 25);
-    history_.push_back({{"stage", "polish"}, {"spheres", s.size()}, {"objective", f}});
+    f = polish(s, 25, 2);
+    note({{"stage", "polish"}, {"spheres", s.size()}, {"objective", f}});
   }
 
   void target_mode(Spheres& s, int cap) {
@@ -493,7 +519,7 @@ class Optimiser {
       const int got = seed(s, std::min(add, cap - static_cast<int>(s.size())));
       refine(s, 12);
       err = ctx_.errors(s).metric;
-      history_.push_back({{"stage", "grow"}, {"spheres", s.size()}, {"error", err}});
+      note({{"stage", "grow"}, {"spheres", s.size()}, {"error", err}});
       if (err <= o_.max_error || got == 0) break;
       add = std::max(1, static_cast<int>(s.size()) / 12);
     }
@@ -511,7 +537,7 @@ class Optimiser {
       const double e = ctx_.errors(t).metric;
       if (e > o_.max_error) break;
       s = std::move(t);
-      history_.push_back({{"stage", "prune"}, {"spheres", s.size()}, {"error", e}});
+      note({{"stage", "prune"}, {"spheres", s.size()}, {"error", e}});
     }
     // Search below: full budget fills (seeding starts, descent, swaps, kicks) at fewer spheres,
     // bisecting between half the pruned count (assumed too few) and the pruned count.
@@ -522,7 +548,7 @@ class Optimiser {
       Spheres t;
       budget_mode(t, mid);
       const double e = ctx_.errors(t).metric;
-      history_.push_back({{"stage", "budget_search"}, {"spheres", t.size()}, {"error", e}});
+      note({{"stage", "budget_search"}, {"spheres", t.size()}, {"error", e}});
       if (e <= o_.max_error) {
         hi = static_cast<int>(t.size());
         s = std::move(t);
@@ -542,6 +568,7 @@ class Optimiser {
   double cap_ = std::numeric_limits<double>::infinity();  // radius cap of seeded spheres, m
   std::int64_t evaluations_ = 0, iterations_ = 0;
   nlohmann::json history_ = nlohmann::json::array();
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace clumpkit::detail {
 
@@ -116,8 +117,8 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
         const Sphere& s = spheres[id];
         const int i0 =
             std::max(ib, static_cast<int>(std::floor((s.center[u] - s.radius - A.u0) / A.du)));
-        const int i1 = std::min(
-            ie - 1, static_cast<int>(std::floor((s.center[u] + s.radius - A.u0) / A.du)));
+        const int i1 =
+            std::min(ie - 1, static_cast<int>(std::floor((s.center[u] + s.radius - A.u0) / A.du)));
         if (i0 > i1) continue;
         const int j0 =
             std::max(0, static_cast<int>(std::floor((s.center[v] - s.radius - A.v0) / A.dv)));
@@ -220,55 +221,114 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
   return e;
 }
 
-void RayCache::local(const Spheres& spheres, int i, double reach, Local& L) const {
-  L.lines.clear();
-  L.t.clear();
-  L.w.clear();
-  L.slope.clear();
+void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int max_lines,
+                     int phase) const {
   L.center = spheres[i].center;
   L.reach = reach;
-  std::vector<std::pair<double, int>> ev;
-  std::vector<int> near;
+  const Eigen::Vector3d& c = L.center;
+  // A large sphere keeps every stride-th row and column of each axis' line grid (the lines stay
+  // evenly spread; each stands for stride^2 of them).
+  double expected = 0.0;
+  for (const Axis& A : axes_) expected += std::numbers::pi * reach * reach / (A.du * A.dv);
+  const int stride =
+      max_lines > 0 ? std::max(1, static_cast<int>(std::ceil(std::sqrt(expected / max_lines)))) : 1;
+  L.scale = static_cast<double>(stride) * stride;
+  const int off_a = stride > 1 ? phase % stride : 0;
+  const int off_b = stride > 1 ? (phase / stride) % stride : 0;
+  // The rows (axis, a) of lines within reach, in a fixed order; each thread builds a contiguous
+  // run of rows into its own part, and the parts are joined in order, so the result does not
+  // depend on the thread count.
+  struct Row {
+    int axis, a, b0, b1;
+  };
+  std::vector<Row> rows;
+  std::vector<int> near[3];
   for (int axis = 0; axis < 3; ++axis) {
     const Axis& A = axes_[axis];
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    const Eigen::Vector3d& c = L.center;
-    near.clear();
     for (int id = 0; id < static_cast<int>(spheres.size()); ++id) {
       const Sphere& s = spheres[id];
       if (id != i && std::abs(s.center[u] - c[u]) < s.radius + reach &&
-          std::abs(s.center[v] - c[v]) < s.radius + reach)
-        near.push_back(id);
+          std::abs(s.center[v] - c[v]) < s.radius + reach &&
+          std::abs(s.center[axis] - c[axis]) < s.radius + reach)
+        near[axis].push_back(id);
     }
     const int i0 = std::max(0, static_cast<int>(std::floor((c[u] - reach - A.u0) / A.du)));
     const int i1 = std::min(A.nu - 1, static_cast<int>(std::floor((c[u] + reach - A.u0) / A.du)));
     const int j0 = std::max(0, static_cast<int>(std::floor((c[v] - reach - A.v0) / A.dv)));
     const int j1 = std::min(A.nv - 1, static_cast<int>(std::floor((c[v] + reach - A.v0) / A.dv)));
+    if (j1 < j0) continue;
     for (int a = i0; a <= i1; ++a)
-      for (int b = j0; b <= j1; ++b) {
-        const int l = a * A.nv + b;
+      if (a % stride == off_a) rows.push_back({axis, a, j0, j1});
+  }
+  const int nrows = static_cast<int>(rows.size());
+  const int parts = std::max(1, std::min(threads_, nrows / 8));
+  L.parts.resize(parts);
+#pragma omp parallel for num_threads(parts) schedule(static, 1)
+  for (int p = 0; p < parts; ++p) {
+    Local::Part& P = L.parts[p];
+    P.lines.clear();
+    P.t.clear();
+    P.w.clear();
+    P.slope.clear();
+    std::vector<std::pair<double, int>> ev;
+    const int r0 = static_cast<int>(static_cast<std::int64_t>(nrows) * p / parts);
+    const int r1 = static_cast<int>(static_cast<std::int64_t>(nrows) * (p + 1) / parts);
+    std::vector<int> row_near;
+    for (int r = r0; r < r1; ++r) {
+      const int axis = rows[r].axis;
+      const Axis& A = axes_[axis];
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      // The other spheres that can cross this row's lines (all lie in one grid cell in u).
+      const double ua = A.u0 + rows[r].a * A.du, ub = ua + A.du;
+      row_near.clear();
+      for (int id : near[axis]) {
+        const Sphere& s = spheres[id];
+        if (s.center[u] + s.radius > ua && s.center[u] - s.radius < ub) row_near.push_back(id);
+      }
+      // Only the window [lo, hi] along the line matters: every trial chord lies in it, and a
+      // chord's value is a difference of W, so W may start from zero at lo.
+      const double lo = c[axis] - reach, hi = c[axis] + reach;
+      for (int b = rows[r].b0; b <= rows[r].b1; ++b) {
+        if (b % stride != off_b) continue;
+        const int l = rows[r].a * A.nv + b;
         const double du = A.pu[l] - c[u], dv = A.pv[l] - c[v];
         if (du * du + dv * dv >= reach * reach) continue;
         ev.clear();
+        bool in_shape = false;
         for (int k = A.first[l]; k < A.first[l + 1]; ++k) {
-          ev.push_back({A.shape[k].t0, 0});
-          ev.push_back({A.shape[k].t1, 0});
+          const double t0 = A.shape[k].t0, t1 = A.shape[k].t1;
+          if (t1 <= lo || t0 >= hi) continue;
+          if (t0 <= lo)
+            in_shape = true;
+          else
+            ev.push_back({t0, 0});
+          if (t1 < hi) ev.push_back({t1, 0});
         }
-        for (int id : near) {
+        int cover = 0;
+        for (int id : row_near) {
           const Sphere& s = spheres[id];
           const double x = A.pu[l] - s.center[u], y = A.pv[l] - s.center[v];
           const double h2 = s.radius * s.radius - x * x - y * y;
           if (h2 <= 0) continue;
           const double hh = std::sqrt(h2);
-          ev.push_back({s.center[axis] - hh, 1});
-          ev.push_back({s.center[axis] + hh, 2});
+          const double t0 = s.center[axis] - hh, t1 = s.center[axis] + hh;
+          if (t1 <= lo || t0 >= hi) continue;
+          if (t0 <= lo)
+            ++cover;
+          else
+            ev.push_back({t0, 1});
+          if (t1 < hi) ev.push_back({t1, 2});
         }
         std::sort(ev.begin(), ev.end(),
                   [](const auto& x, const auto& y) { return x.first < y.first; });
-        Local::Line line{axis, A.pu[l], A.pv[l], static_cast<int>(L.t.size()), 0};
-        int cover = 0;
-        bool in_shape = false;
-        double w = 0.0, prev = ev.empty() ? 0.0 : ev[0].first, sl = 1.0;
+        const int first = static_cast<int>(P.t.size());
+        double w = 0.0, prev = lo;
+        double sl = cover > 0 ? 0.0 : (in_shape ? -1.0 : 1.0);
+        bool zero = sl == 0.0;  // a line wholly covered by other spheres adds nothing: dropped
+        P.t.push_back(lo);
+        P.w.push_back(0.0);
+        P.slope.push_back(sl);
         for (const auto& e : ev) {
           w += sl * (e.first - prev);
           prev = e.first;
@@ -279,53 +339,48 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L) cons
           else
             --cover;
           sl = cover > 0 ? 0.0 : (in_shape ? -1.0 : 1.0);
-          L.t.push_back(e.first);
-          L.w.push_back(w);
-          L.slope.push_back(sl);
-        }
-        line.b1 = static_cast<int>(L.t.size());
-        // A line whose reach is wholly covered by other spheres adds nothing for any trial: drop.
-        const double lo = c[axis] - reach, hi = c[axis] + reach;
-        bool zero = line.b1 > line.b0 && L.t[line.b0] < lo;
-        for (int k = line.b0; zero && k < line.b1; ++k) {
-          const double seg_end = k + 1 < line.b1 ? L.t[k + 1] : 1e300;
-          if (seg_end > lo && L.t[k] < hi && L.slope[k] != 0.0) zero = false;
+          zero = zero && sl == 0.0;
+          P.t.push_back(e.first);
+          P.w.push_back(w);
+          P.slope.push_back(sl);
         }
         if (zero) {
-          L.t.resize(line.b0);
-          L.w.resize(line.b0);
-          L.slope.resize(line.b0);
+          P.t.resize(first);
+          P.w.resize(first);
+          P.slope.resize(first);
           continue;
         }
-        L.lines.push_back(line);
+        P.lines.push_back({axis, A.pu[l], A.pv[l], first, static_cast<int>(P.t.size())});
       }
+    }
   }
 }
 
 double RayCache::local_value(const Local& L, const Sphere& s) const {
-  // W(t) on a line: cumulative weight; before the first breakpoint the slope is +1 (outside).
-  auto W = [&L](const Local::Line& ln, double t) {
-    if (ln.b0 == ln.b1) return t;
-    const double* first = L.t.data() + ln.b0;
-    const double* last = L.t.data() + ln.b1;
-    const double* it = std::upper_bound(first, last, t);
-    if (it == first) return L.w[ln.b0] - (*first - t);
-    const int k = static_cast<int>(it - L.t.data()) - 1;
-    return L.w[k] + L.slope[k] * (t - L.t[k]);
-  };
   double total[3] = {0.0, 0.0, 0.0};
   const double r2 = s.radius * s.radius;
-  for (const Local::Line& ln : L.lines) {
-    const int u = (ln.axis + 1) % 3, v = (ln.axis + 2) % 3;
-    const double x = ln.pu - s.center[u], y = ln.pv - s.center[v];
-    const double h2 = r2 - x * x - y * y;
-    if (h2 <= 0) continue;
-    const double hh = std::sqrt(h2);
-    total[ln.axis] += W(ln, s.center[ln.axis] + hh) - W(ln, s.center[ln.axis] - hh);
+  for (const Local::Part& P : L.parts) {
+    // W(t) on a line: cumulative weight from the window's start (t below it only by round-off).
+    auto W = [&P](const Local::Line& ln, double t) {
+      const double* first = P.t.data() + ln.b0;
+      const double* last = P.t.data() + ln.b1;
+      const double* it = std::upper_bound(first, last, t);
+      if (it == first) return P.w[ln.b0] + P.slope[ln.b0] * (t - *first);
+      const int k = static_cast<int>(it - P.t.data()) - 1;
+      return P.w[k] + P.slope[k] * (t - P.t[k]);
+    };
+    for (const Local::Line& ln : P.lines) {
+      const int u = (ln.axis + 1) % 3, v = (ln.axis + 2) % 3;
+      const double x = ln.pu - s.center[u], y = ln.pv - s.center[v];
+      const double h2 = r2 - x * x - y * y;
+      if (h2 <= 0) continue;
+      const double hh = std::sqrt(h2);
+      total[ln.axis] += W(ln, s.center[ln.axis] + hh) - W(ln, s.center[ln.axis] - hh);
+    }
   }
   double out = 0.0;
   for (int axis = 0; axis < 3; ++axis) out += total[axis] * axes_[axis].du * axes_[axis].dv / 3.0;
-  return out;
+  return out * L.scale;
 }
 
 }  // namespace clumpkit::detail

@@ -33,21 +33,36 @@ class RayCache {
   /// sphere's centre (each axis), the weight function whose integral over a chord is that chord's
   /// contribution to the XOR length given all the other spheres: +1 outside the shape, -1
   /// inside, 0 where another sphere already covers. A trial sphere then costs a binary search per
-  /// line instead of a sweep over every sphere.
+  /// line instead of a sweep over every sphere. Only the window of each line within `reach` of
+  /// the centre is kept (W starts from zero there), and lines are built in parallel.
   struct Local {
     struct Line {
       int axis;
       double pu, pv;
       int b0, b1;  // breakpoints [b0, b1)
     };
-    std::vector<Line> lines;
-    std::vector<double> t, w, slope;  // breakpoint, cumulative weight there, slope after it
+    struct Part {  // the lines one thread built
+      std::vector<Line> lines;
+      std::vector<double> t, w, slope;  // breakpoint, cumulative weight there, slope after it
+    };
+    std::vector<Part> parts;
     Eigen::Vector3d center;
     double reach = 0.0;
+    double scale = 1.0;  // lines each kept line stands for
+    size_t line_count() const {
+      size_t n = 0;
+      for (const Part& p : parts) n += p.lines.size();
+      return n;
+    }
   };
-  void local(const Spheres& spheres, int i, double reach, Local& out) const;
+  /// With `max_lines` > 0, a neighbourhood that would hold more lines keeps an evenly spread
+  /// subset (every k-th row and column of each axis' grid, which ones set by `phase`), so a
+  /// large sphere costs no more than a small one; its values are then estimates.
+  void local(const Spheres& spheres, int i, double reach, Local& out, int max_lines = 0,
+             int phase = 0) const;
   /// XOR volume (m^3, up to a constant) with sphere `i` replaced by `s`, which must lie within
-  /// the neighbourhood's reach. Differences of two calls are exact changes of the XOR volume.
+  /// the neighbourhood's reach. Differences of two calls are exact changes of the XOR volume
+  /// on the cache's rays (without subsampling).
   double local_value(const Local& L, const Sphere& s) const;
 
   double shape_volume() const { return shape_volume_; }
