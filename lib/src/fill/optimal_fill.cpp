@@ -162,11 +162,19 @@ class Optimiser {
     const int reach = static_cast<int>(std::ceil(s.radius / g.h)) + 1;
     const int ci = static_cast<int>(std::lround(q.x())), cj = static_cast<int>(std::lround(q.y())),
               ck = static_cast<int>(std::lround(q.z()));
+    const double r2 = s.radius * s.radius;
     for (int k = std::max(0, ck - reach); k <= std::min(g.n.z() - 1, ck + reach); ++k)
-      for (int j = std::max(0, cj - reach); j <= std::min(g.n.y() - 1, cj + reach); ++j)
-        for (int i = std::max(0, ci - reach); i <= std::min(g.n.x() - 1, ci + reach); ++i)
-          if ((g.center(i, j, k) - s.center).squaredNorm() <= s.radius * s.radius)
-            covered[g.index(i, j, k)] = 1;
+      for (int j = std::max(0, cj - reach); j <= std::min(g.n.y() - 1, cj + reach); ++j) {
+        // The row's chord through the ball, widened by a voxel; the exact test decides.
+        const Eigen::Vector3d p = g.center(ci, j, k) - s.center;
+        const double rest = r2 - p.y() * p.y() - p.z() * p.z();
+        if (rest < 0) continue;
+        const int half = static_cast<int>(std::sqrt(rest) / g.h) + 2;
+        const int x0 = static_cast<int>(std::floor(q.x())) - half;
+        const int x1 = static_cast<int>(std::ceil(q.x())) + half;
+        for (int i = std::max(0, x0); i <= std::min(g.n.x() - 1, x1); ++i)
+          if ((g.center(i, j, k) - s.center).squaredNorm() <= r2) covered[g.index(i, j, k)] = 1;
+      }
   }
 
   // Uncovered inside volume (in voxels) within the ball; sub-sampled for large balls.
@@ -215,29 +223,65 @@ class Optimiser {
       pq.push({4.0 / 3.0 * kPi * rho * rho * rho + 8.0, -1, c});
     }
     int added = 0;
+    std::vector<Item> batch;
+    Spheres placed;  // the sphere placed in each round
     for (int round = 0; round < count && !pq.empty(); ++round) {
       while (!pq.empty()) {
         Item top = pq.top();
         pq.pop();
-        if (top.round == round) {
-          if (top.bound < 0.5) return added;  // nothing left to cover
-          Sphere s;
-          s.center = g.center(0, 0, 0);
-          const std::int64_t v = cand_[top.cand];
-          s.center +=
-              g.h * Eigen::Vector3d(
-                        static_cast<double>(v % g.n.x()),
-                        static_cast<double>((v / g.n.x()) % g.n.y()),
-                        static_cast<double>(v / (static_cast<std::int64_t>(g.n.x()) * g.n.y())));
-          s.radius = std::min(ctx_.max_radius(s.center), cap_);
-          if (s.radius < std::max(o_.min_radius, 1e-6 * ctx_.size)) continue;  // drop candidate
-          spheres.push_back(s);
-          mark(covered, s);
-          ++added;
-          break;
+        if (top.round != round) {
+          // Stale bounds are refreshed a batch at a time, in parallel: the next stale items in
+          // queue order (a fixed number, so the result does not depend on the thread count). A
+          // bound computed in an earlier round is still exact if no sphere placed since then
+          // reaches the candidate's ball.
+          batch.clear();
+          auto take = [&](Item it) {
+            if (it.round >= 0) {
+              const Eigen::Vector3d c = voxel_center(cand_[it.cand]);
+              const double rho = std::min(ctx_.tolerance - g.sdf[cand_[it.cand]], cap_);
+              bool touched = false;
+              for (int k = it.round; k < round && !touched; ++k)
+                touched = (placed[k].center - c).norm() < placed[k].radius + rho + 2.0 * g.h;
+              if (!touched) {
+                it.round = round;
+                pq.push(it);
+                return;
+              }
+            }
+            batch.push_back(it);
+          };
+          take(top);
+          while (batch.size() < 32 && !pq.empty() && pq.top().round != round) {
+            const Item it = pq.top();
+            pq.pop();
+            take(it);
+          }
+          const int nb = static_cast<int>(batch.size());
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
+          for (int k = 0; k < nb; ++k) {
+            const double rho = std::min(ctx_.tolerance - g.sdf[cand_[batch[k].cand]], cap_);
+            batch[k].bound = gain(covered, cand_[batch[k].cand], rho);
+            batch[k].round = round;
+          }
+          for (const Item& it : batch) pq.push(it);
+          continue;
         }
-        const double rho = std::min(ctx_.tolerance - g.sdf[cand_[top.cand]], cap_);
-        pq.push({gain(covered, cand_[top.cand], rho), round, top.cand});
+        if (top.bound < 0.5) return added;  // nothing left to cover
+        Sphere s;
+        s.center = g.center(0, 0, 0);
+        const std::int64_t v = cand_[top.cand];
+        s.center +=
+            g.h * Eigen::Vector3d(
+                      static_cast<double>(v % g.n.x()),
+                      static_cast<double>((v / g.n.x()) % g.n.y()),
+                      static_cast<double>(v / (static_cast<std::int64_t>(g.n.x()) * g.n.y())));
+        s.radius = std::min(ctx_.max_radius(s.center), cap_);
+        if (s.radius < std::max(o_.min_radius, 1e-6 * ctx_.size)) continue;  // drop candidate
+        spheres.push_back(s);
+        placed.push_back(s);
+        mark(covered, s);
+        ++added;
+        break;
       }
     }
     return added;
