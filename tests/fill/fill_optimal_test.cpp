@@ -298,7 +298,7 @@ TEST(FillCli, MeshRoundTripAndOpenMeshRefused) {
 TEST(FillCli, RealMeshesFromDebiansCgalData) {
   const std::filesystem::path archive = "/usr/share/doc/libcgal-dev/data.tar.gz";
   if (!std::filesystem::exists(archive)) GTEST_SKIP() << "libcgal-demo is not installed";
-  const auto dir = scratch("cgal");
+  const auto dir = std::filesystem::path(CLUMPKIT_BINARY_DIR) / "fill_cli_test" / "cgal";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::vector<std::string> fill = {"elephant", "cow", "anchor"};

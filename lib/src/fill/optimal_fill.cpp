@@ -385,7 +385,7 @@ class Optimiser {
   // All but the last `exact_sweeps` sweeps score a large sphere on an evenly spread subset of its
   // rays (at most kPolishLines lines; a different subset each sweep), so a sweep costs about the
   // same whatever the radii; the last sweeps use every ray.
-  static constexpr int kPolishLines = 3000;
+  static constexpr int kPolishLines = 2000;
   double polish(Spheres& s, int sweeps, int exact_sweeps) {
     const int n = static_cast<int>(s.size());
     double f = objective(s);

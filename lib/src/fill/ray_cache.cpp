@@ -18,6 +18,21 @@ std::uint64_t splitmix(std::uint64_t x) {
 double to_unit(std::uint64_t x) {
   return static_cast<double>(x >> 11) * 0x1.0p-53;
 }
+// A line's events are few (a handful of chords): insertion sort beats std::sort there. Stable,
+// so equal positions keep their insertion order.
+template <class T, class Less>
+void sort_small(std::vector<T>& v, Less less) {
+  if (v.size() > 32) {
+    std::stable_sort(v.begin(), v.end(), less);
+    return;
+  }
+  for (size_t k = 1; k < v.size(); ++k) {
+    T x = v[k];
+    size_t m = k;
+    for (; m > 0 && less(x, v[m - 1]); --m) v[m] = v[m - 1];
+    v[m] = x;
+  }
+}
 }  // namespace
 
 RayCache::RayCache(const RaySolid& shape, const Eigen::AlignedBox3d& box, std::int64_t rays,
@@ -159,7 +174,7 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
         ev.push_back({items[k].t0, 1, items[k].id});
         ev.push_back({items[k].t1, 2, items[k].id});
       }
-      std::sort(ev.begin(), ev.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
+      sort_small(ev, [](const Event& a, const Event& b) { return a.t < b.t; });
       int cover = 0;
       long long idsum = 0;
       bool in_shape = false;
@@ -320,8 +335,7 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
             ev.push_back({t0, 1});
           if (t1 < hi) ev.push_back({t1, 2});
         }
-        std::sort(ev.begin(), ev.end(),
-                  [](const auto& x, const auto& y) { return x.first < y.first; });
+        sort_small(ev, [](const auto& x, const auto& y) { return x.first < y.first; });
         const int first = static_cast<int>(P.t.size());
         double w = 0.0, prev = lo;
         double sl = cover > 0 ? 0.0 : (in_shape ? -1.0 : 1.0);
