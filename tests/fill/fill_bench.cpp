@@ -183,6 +183,7 @@ int main(int argc, char** argv) {
       fmt::print("{:<18} target {:.3f}: edt {} spheres, optimal {} spheres, ratio {:.2f}\n", name,
                  ratio_target, need[0], need[1],
                  need[0] > 0 && need[1] > 0 ? static_cast<double>(need[0]) / need[1] : 0.0);
+      std::fflush(stdout);
     }
   }
   if (!svg.empty()) write_svg(svg, shapes, series, counts);
