@@ -204,8 +204,12 @@ class Optimiser {
     return count * s * s * s;
   }
 
-  // Adds up to `count` spheres by lazy-greedy maximum coverage. Returns how many were added.
+  // Adds up to `count` spheres by lazy-greedy maximum coverage, radii capped at `cap`. Returns
+  // how many were added.
   int seed(Spheres& spheres, int count) const {
+    return seed(spheres, count, cap_);
+  }
+  int seed(Spheres& spheres, int count, double cap) const {
     const auto& g = ctx_.grid;
     std::vector<std::uint8_t> covered(g.size(), 0);
     for (const Sphere& s : spheres) mark(covered, s);
@@ -219,7 +223,7 @@ class Optimiser {
     };
     std::priority_queue<Item> pq;
     for (std::int64_t c = 0; c < static_cast<std::int64_t>(cand_.size()); ++c) {
-      const double rho = std::min(ctx_.tolerance - g.sdf[cand_[c]], cap_) / g.h;
+      const double rho = std::min(ctx_.tolerance - g.sdf[cand_[c]], cap) / g.h;
       pq.push({4.0 / 3.0 * kPi * rho * rho * rho + 8.0, -1, c});
     }
     int added = 0;
@@ -238,7 +242,7 @@ class Optimiser {
           auto take = [&](Item it) {
             if (it.round >= 0) {
               const Eigen::Vector3d c = voxel_center(cand_[it.cand]);
-              const double rho = std::min(ctx_.tolerance - g.sdf[cand_[it.cand]], cap_);
+              const double rho = std::min(ctx_.tolerance - g.sdf[cand_[it.cand]], cap);
               bool touched = false;
               for (int k = it.round; k < round && !touched; ++k)
                 touched = (placed[k].center - c).norm() < placed[k].radius + rho + 2.0 * g.h;
@@ -259,7 +263,7 @@ class Optimiser {
           const int nb = static_cast<int>(batch.size());
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
           for (int k = 0; k < nb; ++k) {
-            const double rho = std::min(ctx_.tolerance - g.sdf[cand_[batch[k].cand]], cap_);
+            const double rho = std::min(ctx_.tolerance - g.sdf[cand_[batch[k].cand]], cap);
             batch[k].bound = gain(covered, cand_[batch[k].cand], rho);
             batch[k].round = round;
           }
@@ -275,7 +279,7 @@ class Optimiser {
                       static_cast<double>(v % g.n.x()),
                       static_cast<double>((v / g.n.x()) % g.n.y()),
                       static_cast<double>(v / (static_cast<std::int64_t>(g.n.x()) * g.n.y())));
-        s.radius = std::min(ctx_.max_radius(s.center), cap_);
+        s.radius = std::min(ctx_.max_radius(s.center), cap);
         if (s.radius < std::max(o_.min_radius, 1e-6 * ctx_.size)) continue;  // drop candidate
         spheres.push_back(s);
         placed.push_back(s);
@@ -484,19 +488,23 @@ class Optimiser {
       bool lloyd;
     };
     std::vector<std::pair<double, Spheres>> starts;
-    Spheres capped;  // the r_eq-capped seeding, shared by its plain and Lloyd starts
+    // The three seedings are independent (and serial inside): run side by side.
+    const double caps[3] = {inf, 1.25 * r_eq, r_eq};
+    Spheres seeded[3];
+#pragma omp parallel for num_threads(std::min(threads_, 3)) schedule(dynamic, 1)
+    for (int k = 0; k < 3; ++k) seed(seeded[k], n, caps[k]);
+    int next = 0;
     for (const Start st :
          {Start{inf, false}, Start{1.25 * r_eq, false}, Start{r_eq, false}, Start{r_eq, true}}) {
       cap_ = st.cap;
       step_ = 0.01 * ctx_.size;
       Spheres t;
       if (st.lloyd) {
-        t = capped;
+        t = seeded[2];  // the r_eq-capped seeding, moved by Lloyd iterations
         cap_ = inf;
         lloyd(t, 25);
       } else {
-        seed(t, n);
-        if (st.cap == r_eq) capped = t;
+        t = seeded[next++];
       }
       const double ft = refine(t, 15);
       note({{"stage", "start"},
