@@ -1,6 +1,6 @@
 // clumpkit fill SHAPE --method paper --spheres N -o OUT.json
-// clumpkit fill SHAPE|MESH|TEST_SHAPE --method edt|optimal (--spheres N | --max-error E) -o
-// OUT.json
+// clumpkit fill SHAPE|MESH|TEST_SHAPE --method edt|optimal (--spheres N | --max-error E)
+//              -o OUT.json
 #include <fmt/format.h>
 
 #include <iostream>

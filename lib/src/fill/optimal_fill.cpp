@@ -111,8 +111,8 @@ class Optimiser {
   }
 
   // Lloyd iterations (a centroidal Voronoi tessellation of the inside volume): every centre moves
-  // to the centroid of the inside points nearest to it, then takes the largest admissible radius
-  // (capped). Spreads the spheres evenly, which the largest-first greedy does not.
+  // to the centroid of the inside points nearest to it, then takes the largest admissible
+  // radius. Spreads the spheres evenly, which the largest-first greedy does not.
   void lloyd(Spheres& s, int iters) const {
     const int n = static_cast<int>(s.size());
     if (n == 0) return;
@@ -143,7 +143,7 @@ class Optimiser {
     }
     const double rmin = std::max(o_.min_radius, 1e-6 * ctx_.size);
     for (Sphere& x : s) {
-      x.radius = std::min(ctx_.max_radius(x.center), cap_);
+      x.radius = ctx_.max_radius(x.center);
       if (x.radius < rmin) {  // a centroid outside a non-convex shape: back to the nearest point
         double best = std::numeric_limits<double>::infinity();
         for (const auto& p : inside_pts_)
@@ -151,7 +151,7 @@ class Optimiser {
             best = (p - x.center).squaredNorm();
             x.center = p;
           }
-        x.radius = std::max(rmin, std::min(ctx_.max_radius(x.center), cap_));
+        x.radius = std::max(rmin, ctx_.max_radius(x.center));
       }
     }
   }
@@ -206,10 +206,8 @@ class Optimiser {
 
   // Adds up to `count` spheres by lazy-greedy maximum coverage, radii capped at `cap`. Returns
   // how many were added.
-  int seed(Spheres& spheres, int count) const {
-    return seed(spheres, count, cap_);
-  }
-  int seed(Spheres& spheres, int count, double cap) const {
+  int seed(Spheres& spheres, int count,
+           double cap = std::numeric_limits<double>::infinity()) const {
     const auto& g = ctx_.grid;
     std::vector<std::uint8_t> covered(g.size(), 0);
     for (const Sphere& s : spheres) mark(covered, s);
@@ -392,8 +390,7 @@ class Optimiser {
   static constexpr int kPolishLines = 2000;
   double polish(Spheres& s, int sweeps, int exact_sweeps) {
     const int n = static_cast<int>(s.size());
-    double f = objective(s);
-    if (n == 0) return f;
+    if (n == 0) return objective(s);
     const double vs = ctx_.cache->shape_volume();
     const double rmin = std::max(o_.min_radius, 1e-6 * ctx_.size);
     std::vector<double> delta(n);
@@ -405,15 +402,15 @@ class Optimiser {
       ++iterations_;
       const auto g = gradient(s);
       bool active = false;
+      const int max_lines = sweep >= sweeps - exact_sweeps ? 0 : kPolishLines;
       for (int i = 0; i < n; ++i) {
         if (delta[i] < 2e-3 * s[i].radius) continue;
         active = true;
         const Sphere cur = s[i];
         const double rho_cur = ctx_.max_radius(cur.center);
         // Every trial sphere lies within ball(c, r + 2 delta) (radii grow by at most delta).
-        const bool exact = sweep >= sweeps - exact_sweeps;
-        ctx_.cache->local(s, i, cur.radius + 2.0 * delta[i] + 1e-9 * ctx_.size, L,
-                          exact ? 0 : kPolishLines, sweep * 7 + i);
+        ctx_.cache->local(s, i, cur.radius + 2.0 * delta[i] + 1e-9 * ctx_.size, L, max_lines,
+                          sweep * 7 + i);
         ++evaluations_;
         const double base = ctx_.cache->local_value(L, cur);
         Eigen::Vector3d dc = g[i].c;
@@ -457,7 +454,6 @@ class Optimiser {
           }
         if (best_d < -1e-9 * vs) {
           s[i] = best;
-          f += best_d / vs;
           delta[i] = std::min(1.5 * delta[i], 0.3 * s[i].radius);
         } else {
           delta[i] *= 0.5;
@@ -465,7 +461,7 @@ class Optimiser {
       }
       if (!active) break;
     }
-    return objective(s);  // exact re-evaluation (also clears round-off of the running sum)
+    return objective(s);  // on every ray (the sweeps may have scored subsets)
   }
 
   // ---- swaps and pruning ---------------------------------------------------------------------
@@ -483,38 +479,27 @@ class Optimiser {
     // spheres spread the spheres out. The best start after a short descent goes on.
     const double r_eq = std::cbrt(3.0 * ctx_.cache->shape_volume() / (4.0 * kPi * n));
     const double inf = std::numeric_limits<double>::infinity();
-    struct Start {
-      double cap;
-      bool lloyd;
-    };
-    std::vector<std::pair<double, Spheres>> starts;
-    // The three seedings are independent (and serial inside): run side by side.
+    // Starts: the plain, 1.25 r_eq- and r_eq-capped seedings (independent and serial inside, so
+    // run side by side), then the r_eq-capped one moved by Lloyd iterations.
     const double caps[3] = {inf, 1.25 * r_eq, r_eq};
     Spheres seeded[3];
 #pragma omp parallel for num_threads(std::min(threads_, 3)) schedule(dynamic, 1)
     for (int k = 0; k < 3; ++k) seed(seeded[k], n, caps[k]);
-    int next = 0;
-    for (const Start st :
-         {Start{inf, false}, Start{1.25 * r_eq, false}, Start{r_eq, false}, Start{r_eq, true}}) {
-      cap_ = st.cap;
+    std::vector<std::pair<double, Spheres>> starts;
+    for (int k = 0; k < 4; ++k) {
+      const bool with_lloyd = k == 3;
+      const double cap = caps[std::min(k, 2)];
+      Spheres t = seeded[std::min(k, 2)];
+      if (with_lloyd) lloyd(t, 25);
       step_ = 0.01 * ctx_.size;
-      Spheres t;
-      if (st.lloyd) {
-        t = seeded[2];  // the r_eq-capped seeding, moved by Lloyd iterations
-        cap_ = inf;
-        lloyd(t, 25);
-      } else {
-        t = seeded[next++];
-      }
       const double ft = refine(t, 15);
       note({{"stage", "start"},
-            {"radius_cap", std::isinf(st.cap) ? -1.0 : st.cap},
-            {"lloyd", st.lloyd},
+            {"radius_cap", std::isinf(cap) ? -1.0 : cap},
+            {"lloyd", with_lloyd},
             {"spheres", t.size()},
             {"objective", ft}});
       starts.emplace_back(ft, std::move(t));
     }
-    cap_ = inf;
     // The two best starts are descended and polished in full (the second only if its descent
     // ends within twice the first's objective: polish rarely gains more); the better goes on.
     std::stable_sort(starts.begin(), starts.end(),
@@ -617,7 +602,6 @@ class Optimiser {
   std::vector<Eigen::Vector3d> inside_pts_;  // inside voxel centres (sub-sampled), for Lloyd
   int threads_ = 1;
   double step_ = 0.0;
-  double cap_ = std::numeric_limits<double>::infinity();  // radius cap of seeded spheres, m
   std::int64_t evaluations_ = 0, iterations_ = 0;
   nlohmann::json history_ = nlohmann::json::array();
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();

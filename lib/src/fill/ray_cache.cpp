@@ -238,9 +238,7 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
 
 void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int max_lines,
                      int phase) const {
-  L.center = spheres[i].center;
-  L.reach = reach;
-  const Eigen::Vector3d& c = L.center;
+  const Eigen::Vector3d& c = spheres[i].center;
   // A large sphere keeps every stride-th row and column of each axis' line grid (the lines stay
   // evenly spread; each stands for stride^2 of them).
   double expected = 0.0;

@@ -46,14 +46,7 @@ class RayCache {
       std::vector<double> t, w, slope;  // breakpoint, cumulative weight there, slope after it
     };
     std::vector<Part> parts;
-    Eigen::Vector3d center;
-    double reach = 0.0;
     double scale = 1.0;  // lines each kept line stands for
-    size_t line_count() const {
-      size_t n = 0;
-      for (const Part& p : parts) n += p.lines.size();
-      return n;
-    }
   };
   /// With `max_lines` > 0, a neighbourhood that would hold more lines keeps an evenly spread
   /// subset (every k-th row and column of each axis' grid, which ones set by `phase`), so a
