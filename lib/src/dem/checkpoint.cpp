@@ -181,6 +181,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   in.vec(w.wall_cand);
   in.vec(w.wall_slots);
   in.value(w.need_rebuild);
+  w.wall_active_dirty = true;
   in.value(w.forces_valid);
   in.value(w.elastic);
   const size_t nc = types.size();

@@ -220,7 +220,7 @@ void World::Impl::run_factories() {
                            std::to_string(f.s.attempts_per_clump) +
                            " random tries per clump; enlarge the region, ask for less, or "
                            "insert at a rate");
-    if (stuck && due - have > 2.0 * f.s.rate * f.interval)
+    if (stuck && f.s.fail_if_behind && due - have > 2.0 * f.s.rate * f.interval)
       throw InputError(settings.source, "factories[" + std::to_string(fi) + "].rate",
                        "factory '" + f.s.name + "' falls behind: " + fmt_g(due - have) + unit +
                            " could not be placed in its region (" + describe(region) +

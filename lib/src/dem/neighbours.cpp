@@ -62,32 +62,38 @@ void World::Impl::rebuild_neighbours() {
     bins[s] = {cell_key(sc[s][0], sc[s][1], sc[s][2]), s};
   }
   std::sort(bins.begin(), bins.end());
-  auto range = [&](std::uint64_t key) {
-    auto lo = std::lower_bound(bins.begin(), bins.end(), std::make_pair(key, -1));
+  // The three cells (x, y, z−1 … z+1) are consecutive keys (z is the low field), so each of
+  // the nine (dx, dy) columns is one binary search and one contiguous run of the sorted bins.
+  auto column = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+    auto lo = std::lower_bound(bins.begin(), bins.end(), std::make_pair(cell_key(x, y, z - 1), -1));
+    const std::uint64_t last = cell_key(x, y, z + 1);
     auto hi = lo;
-    while (hi != bins.end() && hi->first == key) ++hi;
+    while (hi != bins.end() && hi->first <= last) ++hi;
     return std::make_pair(lo, hi);
   };
 
-  // Sphere pairs, per sphere i the sorted list of j > i.
-  std::vector<std::vector<int>> near(ns);
+  // Sphere pairs, per sphere i the sorted list of j > i (lists kept between rebuilds so their
+  // storage is reused).
+  std::vector<std::vector<int>>& near = scratch_near;
+  near.resize(ns);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int i = 0; i < ns; ++i) {
     auto& out = near[i];
+    out.clear();
     for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto [lo, hi] = range(cell_key(sc[i][0] + dx, sc[i][1] + dy, sc[i][2] + dz));
-          for (auto it = lo; it != hi; ++it) {
-            const int j = it->second;
-            if (j <= i || s_clump[j] == s_clump[i]) continue;
-            const double rr = s_r[i] + s_r[j] + skin;
-            if ((s_pos[i] - s_pos[j]).squaredNorm() < rr * rr) out.push_back(j);
-          }
+      for (int dy = -1; dy <= 1; ++dy) {
+        auto [lo, hi] = column(sc[i][0] + dx, sc[i][1] + dy, sc[i][2]);
+        for (auto it = lo; it != hi; ++it) {
+          const int j = it->second;
+          if (j <= i || s_clump[j] == s_clump[i]) continue;
+          const double rr = s_r[i] + s_r[j] + skin;
+          if ((s_pos[i] - s_pos[j]).squaredNorm() < rr * rr) out.push_back(j);
         }
+      }
     std::sort(out.begin(), out.end());
   }
   std::vector<PairEntry> next;
+  next.reserve(pairs.size() + pairs.size() / 8);
   for (int i = 0; i < ns; ++i)
     for (int j : near[i]) next.push_back({i, j});
   // Carry histories over (both lists are sorted by (i, j)).
@@ -157,6 +163,21 @@ void World::Impl::rebuild_neighbours() {
   s_pos_build = s_pos;
   for (WallData& wd : walls) wd.vertices_build = wd.vertices;
   need_rebuild = false;
+  refresh_wall_active();
+}
+
+void World::Impl::refresh_wall_active() {
+  const int ns = static_cast<int>(s_r.size());
+  wall_active.clear();
+  for (int s = 0; s < ns; ++s) {
+    bool held = false;
+    for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
+    if (held || wall_cand_start[s] != wall_cand_start[s + 1])
+      wall_active.push_back(s);
+    else
+      wall_contact_n[s] = 0;
+  }
+  wall_active_dirty = false;
 }
 
 }  // namespace clumpkit::dem

@@ -47,6 +47,8 @@ TypeData make_type(const ClumpTypeSettings& t, const std::string& where, const s
   TypeData d;
   d.mass = mp.mass;
   d.inertia = moments;
+  d.inv_mass = 1.0 / d.mass;
+  d.inv_inertia = d.inertia.cwiseInverse();
   d.volume = mp.volume;
   for (const Sphere& s : t.clump.spheres) {
     d.offsets.push_back(axes.transpose() * (s.center - mp.center_of_mass));
@@ -128,6 +130,12 @@ World World::create(WorldSettings s) {
     wall_mat[wd.material] = 1;
     wd.ref_vertices = ws.mesh.vertices;
     wd.triangles = ws.mesh.triangles;
+    for (const auto& t : wd.triangles) {
+      const Eigen::Vector3d n = (wd.ref_vertices[t[1]] - wd.ref_vertices[t[0]])
+                                    .cross(wd.ref_vertices[t[2]] - wd.ref_vertices[t[0]]);
+      const double len = n.norm();
+      wd.ref_normals.push_back(len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero());
+    }
     wd.motion = ws.motion;
     if (ws.torque_reference)
       wd.torque_reference0 = *ws.torque_reference;
@@ -396,6 +404,7 @@ int World::Impl::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quat
     wall_cand_start.push_back(wall_cand_start.back());
   }
   need_rebuild = true;
+  wall_active_dirty = true;
   return c;
 }
 
@@ -489,6 +498,7 @@ int World::remove_clumps(const std::function<bool(int)>& remove) {
   w.wall_cand.clear();
   w.wall_cand_start.assign(ks + 1, 0);
   w.need_rebuild = true;
+  w.wall_active_dirty = true;
   return nc - kept;
 }
 

@@ -21,6 +21,8 @@ struct TypeData {
   std::vector<double> radii;             // m
   double mass = 0.0;                     // kg
   Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // principal moments, kg m^2
+  double inv_mass = 0.0;                                  // 1 / mass, for the integrator
+  Eigen::Vector3d inv_inertia = Eigen::Vector3d::Zero();  // 1 / principal moments
   double bound_radius = 0.0;                          // max |offset| + radius, m
   double volume = 0.0;                                // union volume, m^3
   int material = 0;
@@ -31,9 +33,12 @@ struct WallData {
   int material = 0;
   std::vector<Eigen::Vector3d> ref_vertices;  // at t = 0
   std::vector<std::array<int, 3>> triangles;
+  std::vector<Eigen::Vector3d> ref_normals;  // unit face normals at t = 0 (zero if degenerate)
   WallMotion motion;
   Eigen::Vector3d torque_reference0 = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> vertices;        // current
+  std::vector<Eigen::Vector3d> normals;         // current unit face normals
+  bool normals_turned = false;                  // normals differ from ref_normals
   std::vector<Eigen::Vector3d> vertices_build;  // at the last neighbour rebuild
   WallState state;
 };
@@ -50,6 +55,8 @@ struct PairContactData {
   double overlap = 0.0;
   bool closing = false;  // overlap gone, last damping impulse only (contact_law.hpp)
   ContactForce out;
+  // (point − centre) × force for clumps i and j (forces stage).
+  Eigen::Vector3d moment_i = Eigen::Vector3d::Zero(), moment_j = Eigen::Vector3d::Zero();
 };
 
 inline constexpr int kWallSlots = 4;  // wall contacts kept per sphere
@@ -73,6 +80,8 @@ struct WallContactData {
   double overlap = 0.0;
   bool closing = false;  // overlap gone, last damping impulse only (contact_law.hpp)
   ContactForce out;
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();  // (point − clump centre) × force
+  Eigen::Vector3d wall_velocity = Eigen::Vector3d::Zero();  // wall material at the point
 };
 
 struct FactoryRuntime {
@@ -131,6 +140,11 @@ struct World::Impl {
   std::vector<std::pair<std::uint64_t, std::array<int, 2>>> tri_bins;
   bool tri_bins_valid = false;
   std::vector<std::array<WallSlot, kWallSlots>> wall_slots;
+  // Spheres with wall candidates or a wall contact history, ascending: the only spheres the
+  // wall stages visit. Refreshed at every rebuild and whenever marked dirty (clumps added or
+  // removed, a checkpoint loaded).
+  std::vector<int> wall_active;
+  bool wall_active_dirty = true;
   bool need_rebuild = true;
   double skin = 0.0, cell = 0.0, r_max = 0.0, r_min = 0.0;
 
@@ -144,7 +158,10 @@ struct World::Impl {
   std::string max_overlap_what;
   bool slot_overflow_warned = false;
   // Per-step scratch of detect_contacts (kept to avoid reallocation).
-  std::vector<double> scratch_dist, scratch_ratio;
+  std::vector<double> scratch_ratio;
+  std::vector<std::vector<int>> scratch_near;  // per sphere, rebuild_neighbours
+  std::vector<std::vector<PairContactData>> scratch_pairs;  // per thread
+  std::vector<std::pair<double, int>> scratch_max;          // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
 
   std::vector<FactoryRuntime> factories;
@@ -183,6 +200,7 @@ struct World::Impl {
   double kinetic_energy() const;
   double potential_energy() const;
   void rebuild_neighbours();
+  void refresh_wall_active();
   std::uint64_t compute_fingerprint() const;
 };
 

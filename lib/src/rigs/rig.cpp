@@ -216,7 +216,9 @@ double max_bound_radius(const Ctx& c) {
 }
 
 // A factory pouring `mass` into `region`: all at once when the region can hold it at a loose
-// 20 % solid fraction, else at the scale's pour rate.
+// 20 % solid fraction, else at the scale's pour rate or as fast as the region can take pills,
+// whichever is slower (the small scale's cup asked more of its pour region per batch than
+// random insertion could place, and the factory stopped the run as falling behind).
 dem::FactorySettings pour(const Ctx& c, const dem::Region& region, double mass) {
   dem::FactorySettings f;
   f.name = "pour";
@@ -225,6 +227,7 @@ dem::FactorySettings pour(const Ctx& c, const dem::Region& region, double mass) 
   f.mass = mass;
   const double capacity = dem::region_volume(region) * 0.2 * mean_union_density(c);
   f.rate = mass <= capacity ? 0.0 : c.p.pour_rate;
+  f.fail_if_behind = false;
   f.velocity = Vector3d(0, 0, -0.1);
   return f;
 }

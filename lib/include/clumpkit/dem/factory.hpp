@@ -45,6 +45,11 @@ struct FactorySettings {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< initial velocity, m/s
   bool random_orientation = true;
   int attempts_per_clump = 200;  ///< random placements tried before giving up on a clump
+  /// With a rate: true = an InputError when the region stays full and the factory falls more
+  /// than two batches behind (a scene asked for more than its region can deliver); false = pour
+  /// as fast as the region allows, carrying the deficit (the rigs: they need the mass, not the
+  /// rate).
+  bool fail_if_behind = true;
 };
 
 /// What a factory has done so far.
