@@ -1,6 +1,8 @@
 // World::step and its stages. Integration is velocity Verlet for translation and, for rotation,
 // the symmetric splitting of the free rigid body into rotations about the principal axes
 // (Dullweber, Leimkuhler & McLachlan 1997), which keeps the gyroscopic term exact per sub-step.
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -137,42 +139,56 @@ static inline void half_kick(World::Impl& w, int c, double h) {
 
 void World::Impl::kick_and_drift() {
   const int nc = static_cast<int>(c_x.size());
+  const int ns = static_cast<int>(s_r.size());
   const double h = 0.5 * dt;
-#pragma omp parallel for num_threads(threads) schedule(static) if (nc >= kParallelMin)
-  for (int c = 0; c < nc; ++c) {
-    half_kick(*this, c, h);
-    c_x[c] += dt * c_v[c];
-    // Free rotation over dt: R1(h) R2(h) R3(dt) R2(h) R1(h) in the principal frame.
-    const TypeData& t = types[c_type[c]];
-    Eigen::Vector3d pi = t.inertia.cwiseProduct(c_wb[c]);
-    double qw = c_q[c].w();
-    Eigen::Vector3d qv = c_q[c].vec();
-    static constexpr int kAxis[5] = {0, 1, 2, 1, 0};
-    for (int s = 0; s < 5; ++s) {
-      const int k = kAxis[s];
-      const double tau = s == 2 ? dt : h;
-      const double theta = tau * pi[k] * t.inv_inertia[k];
-      if (theta == 0.0) continue;
-      // One sincos of θ/2 serves the quaternion and (by the double-angle formulas) the
-      // momentum rotation.
-      double sh, ch;
-      half_angle_sincos(0.5 * theta, sh, ch);
-      rotate_momentum(pi, k, 1.0 - 2.0 * sh * sh, 2.0 * sh * ch);
-      // q ← q · (ch, sh e_k), written out: the factor has one vector component.
-      const int a = (k + 1) % 3, b = (k + 2) % 3;
-      const double w0 = qw, vk = qv[k], va = qv[a], vb = qv[b];
-      qw = w0 * ch - sh * vk;
-      qv[k] = w0 * sh + ch * vk;
-      qv[a] = ch * va + sh * vb;
-      qv[b] = ch * vb - sh * va;
+  double ds = 0.0;
+  // One parallel region for the clumps and then their spheres (fewer fork-joins per step); the
+  // spheres' largest displacement since the last neighbour rebuild comes along for free.
+#pragma omp parallel num_threads(threads) if (ns >= kParallelMin)
+  {
+#pragma omp for schedule(static)
+    for (int c = 0; c < nc; ++c) {
+      half_kick(*this, c, h);
+      c_x[c] += dt * c_v[c];
+      // Free rotation over dt: R1(h) R2(h) R3(dt) R2(h) R1(h) in the principal frame.
+      const TypeData& t = types[c_type[c]];
+      Eigen::Vector3d pi = t.inertia.cwiseProduct(c_wb[c]);
+      double qw = c_q[c].w();
+      Eigen::Vector3d qv = c_q[c].vec();
+      static constexpr int kAxis[5] = {0, 1, 2, 1, 0};
+      for (int st = 0; st < 5; ++st) {
+        const int k = kAxis[st];
+        const double tau = st == 2 ? dt : h;
+        const double theta = tau * pi[k] * t.inv_inertia[k];
+        if (theta == 0.0) continue;
+        // One sincos of θ/2 serves the quaternion and (by the double-angle formulas) the
+        // momentum rotation.
+        double sh, ch;
+        half_angle_sincos(0.5 * theta, sh, ch);
+        rotate_momentum(pi, k, 1.0 - 2.0 * sh * sh, 2.0 * sh * ch);
+        // q ← q · (ch, sh e_k), written out: the factor has one vector component.
+        const int a = (k + 1) % 3, b = (k + 2) % 3;
+        const double w0 = qw, vk = qv[k], va = qv[a], vb = qv[b];
+        qw = w0 * ch - sh * vk;
+        qv[k] = w0 * sh + ch * vk;
+        qv[a] = ch * va + sh * vb;
+        qv[b] = ch * vb - sh * va;
+      }
+      Eigen::Quaterniond q(qw, qv.x(), qv.y(), qv.z());
+      q.normalize();
+      c_q[c] = q;
+      c_R[c] = q.toRotationMatrix();
+      c_wb[c] = pi.cwiseProduct(t.inv_inertia);
     }
-    Eigen::Quaterniond q(qw, qv.x(), qv.y(), qv.z());
-    q.normalize();
-    c_q[c] = q;
-    c_R[c] = q.toRotationMatrix();
-    c_wb[c] = pi.cwiseProduct(t.inv_inertia);
+#pragma omp for schedule(static) reduction(max : ds)
+    for (int s = 0; s < ns; ++s) {
+      const int c = s_clump[s];
+      s_pos[s] = c_x[c] + c_R[c] * s_off[s];
+      ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+    }
   }
-  update_spheres(0);
+  drift_disp2 = ds;
+  drift_disp_valid = true;
 }
 
 void World::Impl::kick() {
@@ -204,10 +220,12 @@ void World::Impl::move_walls() {
 void World::Impl::update_neighbours() {
   const int ns = static_cast<int>(s_r.size());
   double ds = 0.0;
-#pragma omp parallel for num_threads(threads) schedule(static) \
-    reduction(max                                              \
-              : ds) if (ns >= kParallelMin)
-  for (int s = 0; s < ns; ++s) ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+  if (drift_disp_valid) {
+    ds = drift_disp2;  // measured by kick_and_drift; spheres added since have not moved
+  } else {
+    for (int s = 0; s < ns; ++s) ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+  }
+  drift_disp_valid = false;
   ds = std::sqrt(ds);
   double dw = 0.0;
   for (const WallData& wd : walls)
@@ -221,68 +239,69 @@ void World::Impl::update_neighbours() {
 }
 
 void World::Impl::detect_contacts() {
-  // Sphere pairs, one pass: each thread takes a contiguous block of the (i, j)-sorted list and
-  // keeps its contacts in order; the blocks are joined in order, so the contact list (and every
-  // sum over it) is the same for any thread count.
+  // Sphere pairs. Each thread takes a contiguous block of the (i, j)-sorted list: first it
+  // notes the pairs in contact (index and distance, 16 bytes each), then, at its block's
+  // offset in the contact list, writes their geometry. The list is the same for any thread
+  // count. Entries are overwritten in place (every field the stages read is assigned), not
+  // re-constructed: zeroing ~200 bytes per contact every step cost more than the scan.
   const int np = static_cast<int>(pairs.size());
   const int nt = np >= kParallelMin ? std::max(threads, 1) : 1;
-  scratch_pairs.resize(nt);
+  scratch_touch.resize(nt);
   scratch_max.assign(nt, {0.0, -1});
-  // Entries are overwritten in place (every field the stages read is assigned), not
-  // re-constructed: zeroing ~200 bytes per contact every step cost more than the scan itself.
-  auto scan = [&](int t, int k0, int k1, std::vector<PairContactData>& out) {
-    double best = 0.0;
-    int best_k = -1;
-    size_t used = 0;
+  std::vector<size_t> offset(nt + 1, 0);
+#pragma omp parallel num_threads(nt) if (nt > 1)
+  {
+    const int t = omp_get_thread_num();
+    const int k0 = static_cast<int>(std::int64_t(np) * t / nt);
+    const int k1 = static_cast<int>(std::int64_t(np) * (t + 1) / nt);
+    std::vector<std::pair<int, double>>& touch = scratch_touch[t];
+    touch.clear();
     for (int k = k0; k < k1; ++k) {
       const PairEntry& p = pairs[k];
       const double rr = s_r[p.i] + s_r[p.j];
-      const Eigen::Vector3d dx = s_pos[p.i] - s_pos[p.j];
-      const double d2 = dx.squaredNorm();
+      const double d2 = (s_pos[p.i] - s_pos[p.j]).squaredNorm();
       ContactHistory& h = pair_hist[k];
-      bool closing = false;
-      if (d2 >= rr * rr) {
-        if (h.damping == 0.0) {
-          // Most listed pairs are apart with an empty history: read, do not rewrite.
-          if (!h.shear.isZero(0.0) || !h.roll.isZero(0.0)) h = ContactHistory{};
-          continue;
-        }
-        // Closing: the overlap ended during the step, one damping impulse is left.
+      if (d2 < rr * rr) {
+        touch.push_back({k, std::sqrt(d2)});
+      } else if (h.damping != 0.0) {
+        // Closing: the overlap ended during the step, one damping impulse is left (a
+        // negative distance marks it).
         h.shear.setZero();
         h.roll.setZero();
-        closing = true;
+        touch.push_back({k, -std::sqrt(d2)});
+      } else if (!h.shear.isZero(0.0) || !h.roll.isZero(0.0)) {
+        // Most listed pairs are apart with an empty history: read, do not rewrite.
+        h = ContactHistory{};
       }
-      if (used == out.size()) out.emplace_back();
-      PairContactData& pc = out[used++];
+    }
+    offset[t + 1] = touch.size();
+#pragma omp barrier
+#pragma omp single
+    {
+      for (int u = 0; u < nt; ++u) offset[u + 1] += offset[u];
+      if (pair_contacts.size() < offset[nt]) pair_contacts.resize(offset[nt]);
+    }
+    double best = 0.0;
+    int best_k = -1;
+    size_t o = offset[t];
+    for (const auto& [k, sd] : touch) {
+      const PairEntry& p = pairs[k];
+      PairContactData& pc = pair_contacts[o++];
+      const double rr = s_r[p.i] + s_r[p.j];
+      const double d = std::abs(sd);
       pc.pair = k;
-      pc.closing = closing;
-      const double d = std::sqrt(d2);
+      pc.closing = sd < 0.0;  // a closing pair is apart: its distance is > 0
       pc.overlap = rr - d;
-      pc.normal = d > 0.0 ? Eigen::Vector3d(dx / d) : Eigen::Vector3d::UnitZ();
+      pc.normal =
+          d > 0.0 ? Eigen::Vector3d((s_pos[p.i] - s_pos[p.j]) / d) : Eigen::Vector3d::UnitZ();
       pc.point = s_pos[p.i] - (s_r[p.i] - 0.5 * pc.overlap) * pc.normal;
-      if (closing) pc.overlap = 0.0;
+      if (pc.closing) pc.overlap = 0.0;
       const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
       if (ratio > best) best = ratio, best_k = k;
     }
-    out.resize(used);
     scratch_max[t] = {best, best_k};
-  };
-  if (nt == 1) {
-    scan(0, 0, np, pair_contacts);
-  } else {
-#pragma omp parallel for num_threads(nt) schedule(static, 1)
-    for (int t = 0; t < nt; ++t)
-      scan(t, int(std::int64_t(np) * t / nt), int(std::int64_t(np) * (t + 1) / nt),
-           scratch_pairs[t]);
-    size_t n = 0;
-    for (int t = 0; t < nt; ++t) n += scratch_pairs[t].size();
-    pair_contacts.resize(n);
-    n = 0;
-    for (int t = 0; t < nt; ++t) {
-      std::copy(scratch_pairs[t].begin(), scratch_pairs[t].end(), pair_contacts.begin() + n);
-      n += scratch_pairs[t].size();
-    }
   }
+  pair_contacts.resize(offset[nt]);
   max_overlap_ratio = 0.0;
   for (int t = 0; t < nt; ++t)
     if (scratch_max[t].first > max_overlap_ratio) {
@@ -431,128 +450,146 @@ void World::Impl::detect_contacts() {
 
 void World::Impl::compute_forces(double hdt) {
   const int nc = static_cast<int>(c_x.size());
+  const int npc = static_cast<int>(pair_contacts.size());
+  const int na = static_cast<int>(wall_active.size());
   c_ww.resize(nc);
   c_vp.resize(nc);
-#pragma omp parallel for num_threads(threads) schedule(static) if (nc >= kParallelMin)
-  for (int c = 0; c < nc; ++c) {
-    c_ww[c] = c_R[c] * c_wb[c];
-    // Predicted v(t) from the half-step velocity and the last forces, for the damping terms:
-    // halves the restitution error at the default step (0.2 T_R).
-    c_vp[c] = c_v[c] + (0.5 * dt) * (types[c_type[c]].inv_mass * c_f[c] + settings.gravity);
-  }
-
-  const int npc = static_cast<int>(pair_contacts.size());
-#pragma omp parallel for num_threads(threads) schedule(static) if (npc >= kParallelMin)
-  for (int k = 0; k < npc; ++k) {
-    PairContactData& pc = pair_contacts[k];
-    const PairEntry& p = pairs[pc.pair];
-    const int ci = s_clump[p.i], cj = s_clump[p.j];
-    const TypeData& ti = types[c_type[ci]];
-    const TypeData& tj = types[c_type[cj]];
-    const ResolvedContact& lw = law(ti.material, tj.material);
-    const Eigen::Vector3d ri = pc.point - c_x[ci], rj = pc.point - c_x[cj];
-    ContactKinematics kin;
-    kin.normal = pc.normal;
-    kin.overlap = pc.overlap;
-    kin.r_star = s_r[p.i] * s_r[p.j] / (s_r[p.i] + s_r[p.j]);
-    kin.m_star = ti.mass * tj.mass / (ti.mass + tj.mass);
-    kin.radius_i = s_r[p.i];
-    kin.radius_j = s_r[p.j];
-    if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) {
-      kin.arm_i = ri.norm();
-      kin.arm_j = rj.norm();
-    }
-    kin.omega_i = c_ww[ci];
-    kin.omega_j = c_ww[cj];
-    const Eigen::Vector3d spin_i = c_ww[ci].cross(ri), spin_j = c_ww[cj].cross(rj);
-    kin.v_rel = (c_v[ci] + spin_i) - (c_v[cj] + spin_j);
-    kin.v_rel_damping = (c_vp[ci] + spin_i) - (c_vp[cj] + spin_j);
-    evaluate_contact(lw, kin, hdt, pair_hist[pc.pair], pc.out);
-    // The force's moments about both centres, here in parallel; the sums below only add.
-    pc.moment_i = ri.cross(pc.out.force);
-    pc.moment_j = rj.cross(pc.out.force);
-  }
-
-  const int na = static_cast<int>(wall_active.size());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (na >= kParallelMin)
-  for (int a = 0; a < na; ++a) {
-    const int s = wall_active[a];
-    const int n = wall_contact_n[s];
-    if (n == 0) continue;
-    const int c = s_clump[s];
-    const TypeData& t = types[c_type[c]];
-    for (int k = 0; k < n; ++k) {
-      WallContactData& wc = wall_contacts[s][k];
-      const WallData& wd = walls[wc.wall];
-      const ResolvedContact& lw = law(t.material, wd.material);
-      const Eigen::Vector3d ri = wc.point - c_x[c];
-      ContactKinematics kin;
-      kin.normal = wc.normal;
-      kin.overlap = wc.overlap;
-      kin.r_star = s_r[s];
-      kin.m_star = t.mass;
-      kin.radius_i = s_r[s];
-      kin.radius_j = 0.0;
-      if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) kin.arm_i = ri.norm();
-      kin.arm_j = 0.0;
-      kin.omega_i = c_ww[c];
-      kin.omega_j = wd.state.pose.omega;
-      const Eigen::Vector3d vw = wd.state.pose.velocity_at(wc.point);
-      const Eigen::Vector3d spin = c_ww[c].cross(ri);
-      kin.v_rel = c_v[c] + spin - vw;
-      kin.v_rel_damping = c_vp[c] + spin - vw;
-      evaluate_contact(lw, kin, hdt, wall_slots[s][k].history, wc.out);
-      wc.moment = ri.cross(wc.out.force);
-      wc.wall_velocity = vw;
-    }
-  }
-
-  // Deterministic accumulation in a fixed order (pairs by (i, j), then spheres by index), so the
-  // sums do not depend on the thread count.
-  for (int c = 0; c < nc; ++c) {
-    c_f[c].setZero();
-    c_t[c].setZero();
-    c_mroll[c] = 0.0;
-  }
   for (WallData& wd : walls) {
     wd.state.force.setZero();
     wd.state.torque.setZero();
   }
   elastic = 0.0;
-  auto add_roll = [&](int c, const Eigen::Vector3d& tq, double m) {
-    c_t[c] += tq;
-    c_mroll[c] += m;
-  };
-  for (const PairContactData& pc : pair_contacts) {
-    const PairEntry& p = pairs[pc.pair];
-    const int ci = s_clump[p.i], cj = s_clump[p.j];
-    const Eigen::Vector3d& f = pc.out.force;
-    c_f[ci] += f;
-    c_f[cj] -= f;
-    c_t[ci] += pc.moment_i;
-    c_t[cj] -= pc.moment_j;
-    const ResolvedContact& lw = law(types[c_type[ci]].material, types[c_type[cj]].material);
-    if (lw.rolling) {
-      add_roll(ci, pc.out.torque_i, pc.out.roll_i);
-      add_roll(cj, pc.out.torque_j, pc.out.roll_j);
+  // One parallel region: clump kinematics, the pair and wall laws, then the sums. Each thread
+  // sums the forces of its own block of clumps, visiting the contacts in list order (pairs by
+  // (i, j), then spheres by index), so every clump's sum is the same sequence of additions for
+  // any thread count; thread 0 also adds up the walls' loads and the energies.
+#pragma omp parallel num_threads(threads) if (npc + static_cast<int>(s_r.size()) >= kParallelMin)
+  {
+#pragma omp for schedule(static)
+    for (int c = 0; c < nc; ++c) {
+      c_ww[c] = c_R[c] * c_wb[c];
+      // Predicted v(t) from the half-step velocity and the last forces, for the damping terms:
+      // halves the restitution error at the default step (0.2 T_R).
+      c_vp[c] = c_v[c] + (0.5 * dt) * (types[c_type[c]].inv_mass * c_f[c] + settings.gravity);
     }
-    elastic += pc.out.elastic_energy;
-  }
-  for (int s : wall_active)
-    for (int k = 0; k < wall_contact_n[s]; ++k) {
-      const WallContactData& wc = wall_contacts[s][k];
-      WallData& wd = walls[wc.wall];
+
+#pragma omp for schedule(static)
+    for (int k = 0; k < npc; ++k) {
+      PairContactData& pc = pair_contacts[k];
+      const PairEntry& p = pairs[pc.pair];
+      const int ci = s_clump[p.i], cj = s_clump[p.j];
+      const TypeData& ti = types[c_type[ci]];
+      const TypeData& tj = types[c_type[cj]];
+      const ResolvedContact& lw = law(ti.material, tj.material);
+      const Eigen::Vector3d ri = pc.point - c_x[ci], rj = pc.point - c_x[cj];
+      ContactKinematics kin;
+      kin.normal = pc.normal;
+      kin.overlap = pc.overlap;
+      kin.r_star = s_r[p.i] * s_r[p.j] / (s_r[p.i] + s_r[p.j]);
+      kin.m_star = ti.mass * tj.mass / (ti.mass + tj.mass);
+      kin.radius_i = s_r[p.i];
+      kin.radius_j = s_r[p.j];
+      if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) {
+        kin.arm_i = ri.norm();
+        kin.arm_j = rj.norm();
+      }
+      kin.omega_i = c_ww[ci];
+      kin.omega_j = c_ww[cj];
+      const Eigen::Vector3d spin_i = c_ww[ci].cross(ri), spin_j = c_ww[cj].cross(rj);
+      kin.v_rel = (c_v[ci] + spin_i) - (c_v[cj] + spin_j);
+      kin.v_rel_damping = (c_vp[ci] + spin_i) - (c_vp[cj] + spin_j);
+      evaluate_contact(lw, kin, hdt, pair_hist[pc.pair], pc.out);
+      pc.moment_i = ri.cross(pc.out.force);
+      pc.moment_j = rj.cross(pc.out.force);
+    }
+
+#pragma omp for schedule(dynamic, 64)
+    for (int a = 0; a < na; ++a) {
+      const int s = wall_active[a];
+      const int n = wall_contact_n[s];
+      if (n == 0) continue;
       const int c = s_clump[s];
-      const Eigen::Vector3d& f = wc.out.force;
-      c_f[c] += f;
-      c_t[c] += wc.moment;
-      const ResolvedContact& lw = law(types[c_type[c]].material, wd.material);
-      if (lw.rolling) add_roll(c, wc.out.torque_i, wc.out.roll_i);
-      wd.state.force -= f;
-      wd.state.torque -= (wc.point - wd.state.torque_reference).cross(f);
-      elastic += wc.out.elastic_energy;
-      wall_work += f.dot(wc.wall_velocity) * hdt;
+      const TypeData& t = types[c_type[c]];
+      for (int k = 0; k < n; ++k) {
+        WallContactData& wc = wall_contacts[s][k];
+        const WallData& wd = walls[wc.wall];
+        const ResolvedContact& lw = law(t.material, wd.material);
+        const Eigen::Vector3d ri = wc.point - c_x[c];
+        ContactKinematics kin;
+        kin.normal = wc.normal;
+        kin.overlap = wc.overlap;
+        kin.r_star = s_r[s];
+        kin.m_star = t.mass;
+        kin.radius_i = s_r[s];
+        kin.radius_j = 0.0;
+        if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) kin.arm_i = ri.norm();
+        kin.arm_j = 0.0;
+        kin.omega_i = c_ww[c];
+        kin.omega_j = wd.state.pose.omega;
+        const Eigen::Vector3d vw = wd.state.pose.velocity_at(wc.point);
+        const Eigen::Vector3d spin = c_ww[c].cross(ri);
+        kin.v_rel = c_v[c] + spin - vw;
+        kin.v_rel_damping = c_vp[c] + spin - vw;
+        evaluate_contact(lw, kin, hdt, wall_slots[s][k].history, wc.out);
+        wc.moment = ri.cross(wc.out.force);
+        wc.wall_velocity = vw;
+      }
     }
+
+    // Sums (the loop above ends in a barrier, so every contact's force is in place).
+    const int nt = omp_get_num_threads(), t = omp_get_thread_num();
+    const int c0 = static_cast<int>(std::int64_t(nc) * t / nt);
+    const int c1 = static_cast<int>(std::int64_t(nc) * (t + 1) / nt);
+    for (int c = c0; c < c1; ++c) {
+      c_f[c].setZero();
+      c_t[c].setZero();
+      c_mroll[c] = 0.0;
+    }
+    auto mine = [&](int c) { return c >= c0 && c < c1; };
+    for (const PairContactData& pc : pair_contacts) {
+      const PairEntry& p = pairs[pc.pair];
+      const int ci = s_clump[p.i], cj = s_clump[p.j];
+      const bool own_i = mine(ci), own_j = mine(cj);
+      if (!own_i && !own_j) continue;
+      const bool rolling = law(types[c_type[ci]].material, types[c_type[cj]].material).rolling;
+      if (own_i) {
+        c_f[ci] += pc.out.force;
+        c_t[ci] += pc.moment_i;
+      }
+      if (own_j) {
+        c_f[cj] -= pc.out.force;
+        c_t[cj] -= pc.moment_j;
+      }
+      if (rolling) {
+        if (own_i) c_t[ci] += pc.out.torque_i, c_mroll[ci] += pc.out.roll_i;
+        if (own_j) c_t[cj] += pc.out.torque_j, c_mroll[cj] += pc.out.roll_j;
+      }
+    }
+    for (int s : wall_active) {
+      const int c = s_clump[s];
+      if (!mine(c)) continue;
+      for (int k = 0; k < wall_contact_n[s]; ++k) {
+        const WallContactData& wc = wall_contacts[s][k];
+        c_f[c] += wc.out.force;
+        c_t[c] += wc.moment;
+        if (law(types[c_type[c]].material, walls[wc.wall].material).rolling)
+          c_t[c] += wc.out.torque_i, c_mroll[c] += wc.out.roll_i;
+      }
+    }
+    if (t == 0) {
+      for (const PairContactData& pc : pair_contacts) elastic += pc.out.elastic_energy;
+      for (int s : wall_active)
+        for (int k = 0; k < wall_contact_n[s]; ++k) {
+          const WallContactData& wc = wall_contacts[s][k];
+          WallData& wd = walls[wc.wall];
+          const Eigen::Vector3d& f = wc.out.force;
+          wd.state.force -= f;
+          wd.state.torque -= (wc.point - wd.state.torque_reference).cross(f);
+          elastic += wc.out.elastic_energy;
+          wall_work += f.dot(wc.wall_velocity) * hdt;
+        }
+    }
+  }
 }
 
 void World::Impl::release_pinched(World& world) {

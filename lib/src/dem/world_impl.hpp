@@ -146,6 +146,10 @@ struct World::Impl {
   std::vector<int> wall_active;
   bool wall_active_dirty = true;
   bool need_rebuild = true;
+  // Largest squared sphere displacement since the rebuild, measured by kick_and_drift for the
+  // update_neighbours that follows it (m^2).
+  double drift_disp2 = 0.0;
+  bool drift_disp_valid = false;
   double skin = 0.0, cell = 0.0, r_max = 0.0, r_min = 0.0;
 
   // Contacts of the current step.
@@ -160,7 +164,7 @@ struct World::Impl {
   // Per-step scratch of detect_contacts (kept to avoid reallocation).
   std::vector<double> scratch_ratio;
   std::vector<std::vector<int>> scratch_near;  // per sphere, rebuild_neighbours
-  std::vector<std::vector<PairContactData>> scratch_pairs;  // per thread
+  std::vector<std::vector<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
   std::vector<std::pair<double, int>> scratch_max;          // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
 
