@@ -323,7 +323,7 @@ void World::Impl::detect_contacts() {
   std::vector<int>& overflow = scratch_overflow;
   ratio_s.assign(na, 0.0);
   overflow.assign(na, 0);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (na >= kParallelMin)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (na >= 64)
   for (int a = 0; a < na; ++a) {
     const int s = wall_active[a];
     struct Cand {
