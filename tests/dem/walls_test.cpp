@@ -211,6 +211,34 @@ TEST(Walls, TurntableCarriesASlab) {
   EXPECT_NEAR(w.positions()[0].head<2>().norm(), 0.02, 1e-4);
 }
 
+// A paddle (the plane x = 0, 4 × 4 squares) turns a quarter turn about z and stops: it is now
+// the plane y = 0. A ball pressed into it from +y feels one contact pushing it along +y. The
+// contact search rejects triangles by their plane distance, so this fails if the cached face
+// normals did not turn with the wall (at x = 5 mm every stale plane test rejects: the rotated
+// vertices sit at x = 0, ±10, ±20 mm).
+TEST(Walls, TurnedWallContactsUseTurnedNormals) {
+  WorldSettings s;
+  s.gravity.setZero();
+  s.materials = test::test_materials(0.5, 0.5, 0.05);
+  const double r = 2e-3;
+  s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
+  WallSettings paddle{"paddle", make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 0.04,
+                                           0.04, 4),
+                      "galvanized_steel", {}, {}};
+  paddle.motion.rotation = WallRotation{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 30.0,
+                                        0.0, 0.5};  // π rad/s for 0.5 s
+  s.walls.push_back(paddle);
+  World w = World::create(s);
+  w.run_until(0.6);
+  w.add_clump(0, Eigen::Vector3d(0.005, r - 1e-6, 0.001));
+  w.step();
+  ASSERT_EQ(w.contact_count(), 1);
+  const Eigen::Vector3d f = w.contact_forces()[0];
+  EXPECT_GT(f.y(), 0.0);
+  EXPECT_NEAR(f.x(), 0.0, 1e-9 * f.norm() + 1e-12);
+  EXPECT_NEAR(f.z(), 0.0, 1e-9 * f.norm() + 1e-12);
+}
+
 // A ball between the floor and a ceiling that comes down at 5 cm/s: a prescribed wall has
 // unlimited force, so the ball is squeezed without end. Without a pinch release the overlap
 // check stops the run; with one the ball is taken out, counted and reported.
