@@ -18,10 +18,12 @@ fs::path data_dir() {
 fs::path resolve_shape(const std::string& arg) {
   std::error_code ec;
   if (fs::exists(arg, ec)) return arg;
-  for (const fs::path& cand : {data_dir() / "shapes" / (arg + ".toml"), data_dir() / "shapes" / arg})
+  for (const fs::path& cand :
+       {data_dir() / "shapes" / (arg + ".toml"), data_dir() / "shapes" / arg})
     if (fs::exists(cand, ec)) return cand;
-  throw InputError(arg, "", "no such shape file (nor a bundled shape in " +
-                                (data_dir() / "shapes").string() + ")");
+  throw InputError(
+      arg, "",
+      "no such shape file (nor a bundled shape in " + (data_dir() / "shapes").string() + ")");
 }
 
 fs::path find_model(const std::string& arg, const std::string& field) {
@@ -32,8 +34,10 @@ fs::path find_model(const std::string& arg, const std::string& field) {
     if (fs::exists(cand, ec)) return cand;
   std::string known;
   for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().extension() == ".toml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
-  throw InputError("", field, "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
+    if (e.path().extension() == ".toml")
+      known += (known.empty() ? "" : ", ") + e.path().stem().string();
+  throw InputError("", field,
+                   "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
 }
 
 void write_json(const nlohmann::json& j, const std::string& target) {
@@ -54,6 +58,8 @@ std::vector<std::pair<int, Registration::Setup>>& registry() {
   return r;
 }
 
-Registration::Registration(int order, Setup setup) { registry().emplace_back(order, setup); }
+Registration::Registration(int order, Setup setup) {
+  registry().emplace_back(order, setup);
+}
 
 }  // namespace clumpkit::cli

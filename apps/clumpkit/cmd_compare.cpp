@@ -92,8 +92,8 @@ void print_comparison(const std::string& model, const Comparison& c) {
         "{:<16} {:<4} {:<26} {:<15} {:>10.4g} {:>9.2g} {:>10.4g} {:>9.2g} {:>+7.2f} {:>+7.1f}% "
         "{} [{}]\n",
         o.measured.rig, o.measured.sample, o.measured.setting_text(), o.measured.quantity,
-        o.measured.value, o.measured.std, o.simulated.mean, o.simulated.std, o.z,
-        100 * o.rel_error, o.pass ? "yes" : "NO ", o.measured.unit);
+        o.measured.value, o.measured.std, o.simulated.mean, o.simulated.std, o.z, 100 * o.rel_error,
+        o.pass ? "yes" : "NO ", o.measured.unit);
   std::cout << fmt::format("chi2 = {:.2f}, dof = {}, chi2/dof = {:.2f}\n", c.chi2, c.dof,
                            c.chi2_per_dof);
 }
@@ -111,13 +111,16 @@ void check_outputs(const CalArgs& a) {
 Command setup_compare(CLI::App& parent) {
   auto a = std::make_shared<CalArgs>();
   CLI::App* c = parent.add_subcommand(
-      "compare", "Run every rig and setting the measurements need and compare: measured and "
-                 "simulated mean +/- std, z, relative error, pass (|z| <= 2), chi2/dof");
-  c->add_option("--model", a->models, "Model file or bundled name; repeat for a chain of model "
-                                      "versions (the report shows chi2/dof per version)")
+      "compare",
+      "Run every rig and setting the measurements need and compare: measured and "
+      "simulated mean +/- std, z, relative error, pass (|z| <= 2), chi2/dof");
+  c->add_option("--model", a->models,
+                "Model file or bundled name; repeat for a chain of model "
+                "versions (the report shows chi2/dof per version)")
       ->required();
-  c->add_option("--measurements", a->measurements, "Measurement CSV (rig,sample,setting,quantity,"
-                                                   "value,std,n,unit)")
+  c->add_option("--measurements", a->measurements,
+                "Measurement CSV (rig,sample,setting,quantity,"
+                "value,std,n,unit)")
       ->required();
   c->add_option("--report", a->report, "Write a self-contained HTML report into this folder");
   common_options(c, *a);
@@ -154,7 +157,8 @@ Command setup_compare(CLI::App& parent) {
             if (!a->report.empty()) {
               rep.pictures = sim.pictures();
               write_report(rep, a->report);
-              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string() << "\n";
+              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string()
+                        << "\n";
             }
             return 0;
           }};
@@ -167,21 +171,25 @@ Command setup_diagnose(CLI::App& parent) {
       "Find the physical effect the model lacks: fit each candidate effect (SPEC §8) to the "
       "measurements with real rig runs, rank by BIC, say which observables drive it, which "
       "effects are indistinguishable and which measurement would separate them");
-  c->add_option("--model", a->models, "Baseline model file or bundled name")->required()->expected(1);
+  c->add_option("--model", a->models, "Baseline model file or bundled name")
+      ->required()
+      ->expected(1);
   c->add_option("--measurements", a->measurements, "Measurement CSV")->required();
   c->add_option("--effects", a->effects, "Comma-separated effect ids to try (default: all)");
   c->add_option("--report", a->report, "Write a self-contained HTML report into this folder");
   c->add_flag("--apply", a->apply, "Write the model with the winning effect at its fitted value");
   c->add_option("-o,--output", a->output, "With --apply: the new model file (.toml)");
-  c->add_flag("--no-suggest", a->no_suggest, "Skip simulating unmeasured settings for the "
-                                              "next-measurement suggestion");
+  c->add_flag("--no-suggest", a->no_suggest,
+              "Skip simulating unmeasured settings for the "
+              "next-measurement suggestion");
   common_options(c, *a);
   return {c, [a] {
             const auto ms = load_measurements(a->measurements);
             if (ms.size() < 3)
               throw InputError(a->measurements, "",
                                fmt::format("{} observable(s) are too few to tell effects apart "
-                                           "(need at least 3)", ms.size()));
+                                           "(need at least 3)",
+                                           ms.size()));
             const ParticleModel base = load_model(find_model(a->models.front()), data_dir());
             if (a->apply && a->output.empty())
               throw InputError("", "--output", "--apply needs -o NEW_MODEL.toml");
@@ -201,12 +209,13 @@ Command setup_diagnose(CLI::App& parent) {
               if (p > 0) o.effects.push_back(list.substr(0, p));
             if (!list.empty()) o.effects.push_back(list);
             effect_candidates(base, o.effects, nullptr, "--effects");  // names checked up front
-            if (!a->quiet) o.progress = [](const std::string& s) { std::cerr << "diagnose: " << s << "\n"; };
+            if (!a->quiet)
+              o.progress = [](const std::string& s) { std::cerr << "diagnose: " << s << "\n"; };
             RigSimulator sim = make_sim(*a);
             const Diagnosis d = diagnose(base, ms, sim, o);
             std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9} {:>9} {:>9} {:>7} {}\n",
-                                     "effect", "parameter", "fitted", "+/-", "chi2", "dchi2",
-                                     "BIC", "weight", "plausible");
+                                     "effect", "parameter", "fitted", "+/-", "chi2", "dchi2", "BIC",
+                                     "weight", "plausible");
             std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9.2f} {:>9} {:>9.2f}\n",
                                      "(baseline)", base.name, "", "", d.baseline.chi2, "",
                                      d.baseline_bic);
@@ -236,8 +245,11 @@ Command setup_diagnose(CLI::App& parent) {
                                {"at_bound", r.at_bound}});
             json sugg = json::array();
             for (const auto& s : d.suggestions)
-              sugg.push_back({{"rig", s.rig}, {"sample", s.sample}, {"setting", s.setting},
-                              {"quantity", s.quantity}, {"separation_sigma", s.separation},
+              sugg.push_back({{"rig", s.rig},
+                              {"sample", s.sample},
+                              {"setting", s.setting},
+                              {"quantity", s.quantity},
+                              {"separation_sigma", s.separation},
                               {"between", s.between}});
             json out = {{"baseline", comparison_json(d.baseline)},
                         {"baseline_bic", d.baseline_bic},
@@ -279,7 +291,8 @@ Command setup_diagnose(CLI::App& parent) {
               rep.diagnosis = &d;
               rep.pictures = sim.pictures();
               write_report(rep, a->report);
-              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string() << "\n";
+              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string()
+                        << "\n";
             }
             return 0;
           }};
@@ -289,8 +302,9 @@ Command setup_synth(CLI::App& parent) {
   auto a = std::make_shared<CalArgs>();
   std::string templ;
   CLI::App* c = parent.add_subcommand(
-      "synth", "Synthetic measurements from a truth model with realistic noise, to check the "
-               "compare/diagnose loop end to end");
+      "synth",
+      "Synthetic measurements from a truth model with realistic noise, to check the "
+      "compare/diagnose loop end to end");
   c->add_option("--model", a->models, "Truth model file or bundled name")->required()->expected(1);
   c->add_option("--measurements-template", a->measurements,
                 "CSV whose rows (rig, sample, setting, quantity, n, unit) are synthesised")
@@ -317,11 +331,11 @@ Command setup_synth(CLI::App& parent) {
               m.value = v + g(rng);
               if (m.value < 0 && m.unit != "deg") m.value = 0.0;
             }
-            write_file_atomic(a->output,
-                              fmt::format("# synthetic: truth model {}, noise {} relative, seed {}, "
-                                          "scale {}\n",
-                                          truth.name, a->noise, a->seed, a->scale) +
-                                  format_measurements(ms));
+            write_file_atomic(
+                a->output, fmt::format("# synthetic: truth model {}, noise {} relative, seed {}, "
+                                       "scale {}\n",
+                                       truth.name, a->noise, a->seed, a->scale) +
+                               format_measurements(ms));
             std::cout << fmt::format("wrote {} measurements to {}\n", ms.size(), a->output);
             return 0;
           }};

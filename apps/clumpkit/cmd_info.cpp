@@ -16,8 +16,9 @@ struct InfoArgs {
 
 Command setup(CLI::App& parent) {
   auto args = std::make_shared<InfoArgs>();
-  CLI::App* c = parent.add_subcommand("info", "Summarise a clump template (spheres, mass "
-                                              "properties, frame, provenance)");
+  CLI::App* c = parent.add_subcommand("info",
+                                      "Summarise a clump template (spheres, mass "
+                                      "properties, frame, provenance)");
   c->add_option("CLUMP", args->clump, "Clump template (.json)")->required();
   c->add_option("--json", args->json, "Also write the template's summary as JSON (FILE or -)");
   return {c, [args] {

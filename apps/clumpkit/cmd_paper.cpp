@@ -22,8 +22,9 @@ struct PaperArgs {
 Command setup(CLI::App& parent) {
   auto args = std::make_shared<PaperArgs>();
   CLI::App* c = parent.add_subcommand(
-      "paper", "The paper's nine clump models: fill pills A, B, C (A/B 4, 12, 20; C 2, 12, 18 "
-               "spheres) and print sphere counts and union mass properties");
+      "paper",
+      "The paper's nine clump models: fill pills A, B, C (A/B 4, 12, 20; C 2, 12, 18 "
+      "spheres) and print sphere counts and union mass properties");
   c->add_option("--out", args->out, "Also write the nine templates to this folder");
   c->add_option("--json", args->json, "Write the table as JSON (FILE or -)");
   c->add_option("--rays", args->rays, "Rays per mass-property integration")
@@ -39,13 +40,11 @@ Command setup(CLI::App& parent) {
             nlohmann::json rows = nlohmann::json::array();
             std::cout << fmt::format(
                 "{:<6} {:>7} {:>8} {:>10} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "model",
-                "spheres", "r (mm)", "V (mm^3)", "V/Vcyl", "m (g)", "I1", "I2", "I3",
-                "Icyl3");
-            std::cout << fmt::format("{:<6} {:>7} {:>8} {:>10} {:>10} {:>9} {:>29} {:>9}\n", "",
-                                     "", "", "union", "", "union", "principal, g mm^2", "");
+                "spheres", "r (mm)", "V (mm^3)", "V/Vcyl", "m (g)", "I1", "I2", "I3", "Icyl3");
+            std::cout << fmt::format("{:<6} {:>7} {:>8} {:>10} {:>10} {:>9} {:>29} {:>9}\n", "", "",
+                                     "", "union", "", "union", "principal, g mm^2", "");
             for (const PaperModel& pm : paper_models()) {
-              const ShapeSpec shape =
-                  load_shape(resolve_shape(std::string("pill_") + pm.pill));
+              const ShapeSpec shape = load_shape(resolve_shape(std::string("pill_") + pm.pill));
               PaperFillRequest req;
               req.spheres = pm.spheres;
               req.sampling.rays = args->rays;
@@ -60,18 +59,17 @@ Command setup(CLI::App& parent) {
                   t.spheres.front().radius * 1e3, m.volume * 1e9, m.volume / cyl.volume,
                   m.mass * 1e3, m.principal_moments[0] * 1e9, m.principal_moments[1] * 1e9,
                   m.principal_moments[2] * 1e9, cyl.principal_moments[2] * 1e9);
-              rows.push_back({{"model", fmt::format("{}{}", pm.pill, pm.spheres)},
-                              {"pill", std::string(1, pm.pill)},
-                              {"spheres", t.spheres.size()},
-                              {"sphere_radius_m", t.spheres.front().radius},
-                              {"union_volume_m3", m.volume},
-                              {"cylinder_volume_m3", cyl.volume},
-                              {"union_mass_kg", m.mass},
-                              {"principal_moments_kg_m2",
-                               {m.principal_moments[0], m.principal_moments[1],
-                                m.principal_moments[2]}}});
-              if (!args->out.empty())
-                save_clump(t, fs::path(args->out) / (t.name + ".json"));
+              rows.push_back(
+                  {{"model", fmt::format("{}{}", pm.pill, pm.spheres)},
+                   {"pill", std::string(1, pm.pill)},
+                   {"spheres", t.spheres.size()},
+                   {"sphere_radius_m", t.spheres.front().radius},
+                   {"union_volume_m3", m.volume},
+                   {"cylinder_volume_m3", cyl.volume},
+                   {"union_mass_kg", m.mass},
+                   {"principal_moments_kg_m2",
+                    {m.principal_moments[0], m.principal_moments[1], m.principal_moments[2]}}});
+              if (!args->out.empty()) save_clump(t, fs::path(args->out) / (t.name + ".json"));
             }
             std::cout << "V/Vcyl: union volume over the true cylinder's; masses at 1380 kg/m^3 on "
                          "the sphere-union basis.\n";

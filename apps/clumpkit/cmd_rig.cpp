@@ -56,7 +56,8 @@ Command setup(CLI::App& parent) {
                 "Particle model: a file or a bundled name (shapes/models/: production, "
                 "paper_A12, ...)")
       ->capture_default_str();
-  c->add_option("--scale", a->scale, "tiny (smoke tests) | mini (quick) | small | paper (the paper's sizes)");
+  c->add_option("--scale", a->scale,
+                "tiny (smoke tests) | mini (quick) | small | paper (the paper's sizes)");
   c->add_option("--repeats", a->repeats, "Repeats with seeds seed, seed+1, ...")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();

@@ -40,16 +40,19 @@ int report(const sim::RunSummary& s, const std::string& out) {
 Command setup(CLI::App& parent) {
   auto a = std::make_shared<SimArgs>();
   CLI::App* c = parent.add_subcommand(
-      "sim", "Run a DEM scene file (clumps, materials, walls, factories) with VTK/CSV output, "
-             "progress, checkpoints; --resume continues a killed run");
+      "sim",
+      "Run a DEM scene file (clumps, materials, walls, factories) with VTK/CSV output, "
+      "progress, checkpoints; --resume continues a killed run");
   c->add_option("SCENE", a->scene, "Scene file (.toml, see docs/scene_format.md)");
-  c->add_option("--until", a->until, "Simulated end time with unit, e.g. \"0.5 s\" (default: "
-                                     "the scene's)");
+  c->add_option("--until", a->until,
+                "Simulated end time with unit, e.g. \"0.5 s\" (default: "
+                "the scene's)");
   c->add_option("--threads", a->threads, "Threads (default: the scene's, else all cores)")
       ->check(CLI::Range(1, 256));
   c->add_option("--out", a->out, "Output folder");
-  c->add_option("--resume", a->resume, "Continue the run in this output folder from its last "
-                                       "checkpoint");
+  c->add_option("--resume", a->resume,
+                "Continue the run in this output folder from its last "
+                "checkpoint");
   c->add_flag("--quiet", a->quiet, "No progress lines");
   return {c, [a] {
             sim::install_stop_handlers();
@@ -64,7 +67,8 @@ Command setup(CLI::App& parent) {
             o.out = a->out;
             o.threads = a->threads;
             o.progress = !a->quiet;
-            if (!a->until.empty()) o.until = parse_quantity(a->until, Dimension::Time, "", "--until");
+            if (!a->until.empty())
+              o.until = parse_quantity(a->until, Dimension::Time, "", "--until");
             return report(sim::run_scene(scene, o), a->out);
           }};
 }

@@ -36,8 +36,8 @@ class FakeSimulator final : public Simulator {
                              15 * (e_pp - 0.5) + 2.0 * (spheres - 12);
     } else if (r.rig == "angle_of_repose") {
       // A free heap: wall (plate) friction matters little, cohesion and rolling friction a lot.
-      const double a = 14 + 25 * std::tanh(2 * mur) + 8 * mus + 1.2e-3 * coh + 1.5 * std::tanh(muw) -
-                       0.3 * (20 - spheres) + 2 * (0.5 - e_pp);
+      const double a = 14 + 25 * std::tanh(2 * mur) + 8 * mus + 1.2e-3 * coh +
+                       1.5 * std::tanh(muw) - 0.3 * (20 - spheres) + 2 * (0.5 - e_pp);
       mean["angle"] = a;
       mean["angle_left"] = a + 0.2;
       mean["angle_right"] = a - 0.2;

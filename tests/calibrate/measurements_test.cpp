@@ -19,14 +19,14 @@ std::string error_of(const std::string& body) {
 }  // namespace
 
 TEST(Measurements, ReadsTheSpecFormat) {
-  const auto m = parse_measurements(
-      "# lab, March\n" + kHeader +
-          "bulk_density,A,,bulk_density,712.4,6.1,3,kg/m^3\n"
-          "angle_of_repose,mix,plate=galvanized_steel,angle,27.3,0.8,3,deg\n"
-          "\n"
-          "discharge,mix,rpm=15,pocket_mass,240,5,3,g\n"
-          "discharge,mix,rpm=30,pocket_mass_cv,0.04,0.01,3,1\n",
-      "m.csv");
+  const auto m =
+      parse_measurements("# lab, March\n" + kHeader +
+                             "bulk_density,A,,bulk_density,712.4,6.1,3,kg/m^3\n"
+                             "angle_of_repose,mix,plate=galvanized_steel,angle,27.3,0.8,3,deg\n"
+                             "\n"
+                             "discharge,mix,rpm=15,pocket_mass,240,5,3,g\n"
+                             "discharge,mix,rpm=30,pocket_mass_cv,0.04,0.01,3,1\n",
+                         "m.csv");
   ASSERT_EQ(m.size(), 4u);
   EXPECT_EQ(m[0].line, 3);
   EXPECT_DOUBLE_EQ(m[0].value, 712.4);
@@ -54,9 +54,12 @@ TEST(Measurements, BadLinesAreNamed) {
   const Case cases[] = {
       {"heap,A,,angle,25,1,3,deg\n", "m.csv:2: rig: unknown rig 'heap'"},
       {"angle_of_repose,D,,angle,25,1,3,deg\n", "m.csv:2: sample: unknown sample 'D'"},
-      {"angle_of_repose,A,,slope,25,1,3,deg\n", "m.csv:2: quantity: rig 'angle_of_repose' does not"},
-      {"angle_of_repose,A,rpm=10,angle,25,1,3,deg\n", "m.csv:2: setting: rig 'angle_of_repose' has no setting 'rpm'"},
-      {"discharge,mix,rpm=fast,pocket_mass,0.25,0.01,3,kg\n", "m.csv:2: setting: setting rpm='fast'"},
+      {"angle_of_repose,A,,slope,25,1,3,deg\n",
+       "m.csv:2: quantity: rig 'angle_of_repose' does not"},
+      {"angle_of_repose,A,rpm=10,angle,25,1,3,deg\n",
+       "m.csv:2: setting: rig 'angle_of_repose' has no setting 'rpm'"},
+      {"discharge,mix,rpm=fast,pocket_mass,0.25,0.01,3,kg\n",
+       "m.csv:2: setting: setting rpm='fast'"},
       {"angle_of_repose,A,,angle,25,1,3,kg\n", "m.csv:2: unit: unit 'kg' is not a unit of angle"},
       {"angle_of_repose,A,,angle,25,,3,deg\n", "m.csv:2: std: missing"},
       {"angle_of_repose,A,,angle,25,-1,3,deg\n", "m.csv:2: std: must be positive"},
@@ -87,10 +90,11 @@ TEST(Measurements, BadLinesAreNamed) {
 }
 
 TEST(Measurements, FormatRoundTrips) {
-  const auto m = parse_measurements(kHeader +
-                                        "discharge,mix,rpm=15,pocket_mass,0.24,0.005,3,kg\n"
-                                        "angle_of_repose,C,plate=abs_plastic,angle_left,26.1,0.9,3,deg\n",
-                                    "m.csv");
+  const auto m =
+      parse_measurements(kHeader +
+                             "discharge,mix,rpm=15,pocket_mass,0.24,0.005,3,kg\n"
+                             "angle_of_repose,C,plate=abs_plastic,angle_left,26.1,0.9,3,deg\n",
+                         "m.csv");
   const auto r = parse_measurements(format_measurements(m), "r.csv");
   ASSERT_EQ(r.size(), m.size());
   for (size_t i = 0; i < m.size(); ++i) {

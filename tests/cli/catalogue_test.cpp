@@ -57,7 +57,7 @@ struct Case {
   std::vector<std::string> absent;
   std::vector<std::string> outputs;  // folders where a failing run may leave (NaN-free) files
   bool allow_warnings = false;       // lines before the diagnosis must be warnings
-  std::string load_error;  // a malformed catalogue entry becomes one failing case
+  std::string load_error;            // a malformed catalogue entry becomes one failing case
 };
 
 // gtest prints the parameter of a failing case: its name, not its bytes.

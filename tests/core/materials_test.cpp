@@ -30,8 +30,9 @@ TEST(Materials, UnknownMaterialListsKnownOnes) {
     lib.get("steel", "scene.toml:4", "walls.0.material");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.toml:4: walls.0.material: unknown material 'steel'"),
-              std::string::npos);
+    EXPECT_NE(
+        std::string(e.what()).find("scene.toml:4: walls.0.material: unknown material 'steel'"),
+        std::string::npos);
     EXPECT_NE(std::string(e.what()).find("galvanized_steel"), std::string::npos);
   }
   EXPECT_THROW(lib.interaction("abs_plastic", "organic_glass"), InputError);

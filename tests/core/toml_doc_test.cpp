@@ -30,16 +30,19 @@ TEST(TomlDoc, TypedAccessWithUnits) {
 
 TEST(TomlDoc, ErrorsNameFileLineAndKey) {
   TomlDoc d = TomlDoc::parse("[shape]\nkind = 3\nheight = 5.4\nd = \"-1 mm\"\n", "t.toml");
-  EXPECT_NE(error_of([&] { d.string("shape.kind"); }).find("t.toml:2: shape.kind: expected a string"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { d.string("shape.kind"); }).find("t.toml:2: shape.kind: expected a string"),
+      std::string::npos);
   EXPECT_NE(error_of([&] { d.quantity("shape.height", Dimension::Length); }).find("needs a unit"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { d.quantity("shape.missing", Dimension::Length); })
-                .find("t.toml: shape.missing: missing"),
+  EXPECT_NE(error_of([&] {
+              d.quantity("shape.missing", Dimension::Length);
+            }).find("t.toml: shape.missing: missing"),
             std::string::npos);
   const double v = d.quantity("shape.d", Dimension::Length);
-  EXPECT_NE(error_of([&] { d.require_range("shape.d", v, 0.0, 1.0, true); })
-                .find("t.toml:4: shape.d: value -0.001 is outside (0, 1]"),
+  EXPECT_NE(error_of([&] {
+              d.require_range("shape.d", v, 0.0, 1.0, true);
+            }).find("t.toml:4: shape.d: value -0.001 is outside (0, 1]"),
             std::string::npos);
 }
 

@@ -222,9 +222,11 @@ TEST(Walls, TurnedWallContactsUseTurnedNormals) {
   s.materials = test::test_materials(0.5, 0.5, 0.05);
   const double r = 2e-3;
   s.clump_types.push_back(test::sphere_type("ball", r, 1380.0));
-  WallSettings paddle{"paddle", make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 0.04,
-                                           0.04, 4),
-                      "galvanized_steel", {}, {}};
+  WallSettings paddle{"paddle",
+                      make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 0.04, 0.04, 4),
+                      "galvanized_steel",
+                      {},
+                      {}};
   paddle.motion.rotation = WallRotation{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 30.0,
                                         0.0, 0.5};  // π rad/s for 0.5 s
   s.walls.push_back(paddle);

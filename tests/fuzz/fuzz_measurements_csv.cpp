@@ -25,9 +25,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     CLUMPKIT_FUZZ_CHECK(again.size() == ms.size(), "round trip changed the count");
     for (size_t i = 0; i < ms.size(); ++i) {
       CLUMPKIT_FUZZ_CHECK(again[i].key() == ms[i].key(), "round trip changed " + ms[i].key());
-      CLUMPKIT_FUZZ_CHECK(std::abs(again[i].value - ms[i].value) <=
-                              1e-9 * std::max(1.0, std::abs(ms[i].value)),
-                          "round trip changed the value of " + ms[i].key());
+      CLUMPKIT_FUZZ_CHECK(
+          std::abs(again[i].value - ms[i].value) <= 1e-9 * std::max(1.0, std::abs(ms[i].value)),
+          "round trip changed the value of " + ms[i].key());
       CLUMPKIT_FUZZ_CHECK(again[i].n == ms[i].n, "round trip changed n");
     }
   });

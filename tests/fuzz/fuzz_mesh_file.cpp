@@ -18,7 +18,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch_file(const char* ext) {
-  const fs::path dir = fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
+  const fs::path dir =
+      fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
   return dir / ("clumpkit_fuzz_mesh_" + std::to_string(::getpid()) + ext);
 }
 
@@ -43,7 +44,10 @@ void check_mesh(const clumpkit::TriangleMesh& m, const clumpkit::MeshReport& r, 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace clumpkit;
   if (size == 0) return 0;
-  const char* ext = data[0] == 'o' ? ".obj" : data[0] == 'p' ? ".ply" : data[0] == 'f' ? ".off" : ".stl";
+  const char* ext = data[0] == 'o'   ? ".obj"
+                    : data[0] == 'p' ? ".ply"
+                    : data[0] == 'f' ? ".off"
+                                     : ".stl";
   const fs::path path = scratch_file(ext);
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -18,11 +18,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     double sum = 0.0;
     for (const ModelType& t : m.types) {
       CLUMPKIT_FUZZ_CHECK(!t.name.empty(), "type without a name");
-      CLUMPKIT_FUZZ_CHECK(std::isfinite(t.mass_fraction) && t.mass_fraction > 0.0 &&
-                              t.mass_fraction <= 1.0 + 1e-12,
-                          "mass fraction of " + t.name);
-      CLUMPKIT_FUZZ_CHECK(t.paper_spheres || !t.clump_path.empty() ||
-                              m.effects.shape_resolution,
+      CLUMPKIT_FUZZ_CHECK(
+          std::isfinite(t.mass_fraction) && t.mass_fraction > 0.0 && t.mass_fraction <= 1.0 + 1e-12,
+          "mass fraction of " + t.name);
+      CLUMPKIT_FUZZ_CHECK(t.paper_spheres || !t.clump_path.empty() || m.effects.shape_resolution,
                           "type " + t.name + " has neither a sphere count nor a clump file");
       if (m.mass_basis == MassBasis::kGiven)
         CLUMPKIT_FUZZ_CHECK(t.given_mass && std::isfinite(*t.given_mass) && *t.given_mass > 0.0,

@@ -18,7 +18,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scene_path() {
-  const fs::path base = fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
+  const fs::path base =
+      fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
   const fs::path dir = base / ("clumpkit_fuzz_scene_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   // Files the seed scenes refer to by relative path: a clump template and an open wall mesh.

@@ -14,7 +14,9 @@ using namespace clumpkit;
 constexpr double kPi = std::numbers::pi;
 
 namespace {
-double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+double sphere_volume(double r) {
+  return 4.0 / 3.0 * kPi * r * r * r;
+}
 // Volume of the lens where two spheres (radii r1, r2, centre distance d) overlap.
 double lens_volume(double r1, double r2, double d) {
   if (d >= r1 + r2) return 0.0;
@@ -32,7 +34,8 @@ TEST(RayMoments, SphereMatchesClosedForm) {
   const MassProperties ref = sphere_mass_properties(r, 1000.0);
   EXPECT_NEAR(mp.volume / ref.volume, 1.0, 1e-3);
   EXPECT_LE(std::abs(mp.volume - ref.volume), std::max(3.0 * ci.volume, 1e-6 * ref.volume));
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(mp.principal_moments[k] / ref.principal_moments[k], 1.0, 1e-3);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(mp.principal_moments[k] / ref.principal_moments[k], 1.0, 1e-3);
   EXPECT_NEAR((mp.center_of_mass - Eigen::Vector3d(0.2e-3, -0.1e-3, 0.4e-3)).norm(), 0.0, 1e-7);
 }
 

@@ -71,13 +71,16 @@ TEST(Scene, BadScenesNameFileAndField) {
        "walls.0.primitive: unknown primitive 'sphere'"},
       {kBase + "[[walls]]\nname = \"w\"\nmaterial = \"abs_plastic\"\nmesh = \"nope.stl\"\n",
        "nope.stl"},
-      {kBase + "[[factories]]\nregion = { kind = \"box\", min = \"0 0 0 mm\", max = \"9 9 9 mm\" }\n"
-               "count = 3\nmass = \"1 kg\"\nmixture = [{ clump = \"B12\" }]\n",
+      {kBase +
+           "[[factories]]\nregion = { kind = \"box\", min = \"0 0 0 mm\", max = \"9 9 9 mm\" }\n"
+           "count = 3\nmass = \"1 kg\"\nmixture = [{ clump = \"B12\" }]\n",
        "factories.0: give exactly one of 'count' and 'mass'"},
-      {kBase + "[[factories]]\nregion = { kind = \"box\", min = \"0 0 0 mm\", max = \"9 9 9 mm\" }\n"
-               "count = 3\nmixture = [{ clump = \"B13\" }]\n",
+      {kBase +
+           "[[factories]]\nregion = { kind = \"box\", min = \"0 0 0 mm\", max = \"9 9 9 mm\" }\n"
+           "count = 3\nmixture = [{ clump = \"B13\" }]\n",
        "B13"},
-      {"[simulation]\nuntil = \"0.1 s\"\n[[clumps]]\nname = \"x\"\nshape = \"pill_A\"\nspheres = 7\n",
+      {"[simulation]\nuntil = \"0.1 s\"\n[[clumps]]\nname = \"x\"\nshape = \"pill_A\"\nspheres = "
+       "7\n",
        "clumps.0.spheres"},
       {"[simulation]\nuntil = \"-1 s\"\n", "simulation.until: value -1 is outside"},
       {kBase + "[simulation.x]\n", ""},

@@ -23,11 +23,19 @@ std::uint64_t run(int threads) {
   s.threads = threads;
   s.seed = 5;
   s.rayleigh_fraction = 0.3;
-  WallSettings box{"box", make_box(Eigen::Vector3d(-0.012, -0.012, 0), Eigen::Vector3d(0.012, 0.012, 0.04)),
-                   "galvanized_steel", {}, {}};
+  WallSettings box{
+      "box",
+      make_box(Eigen::Vector3d(-0.012, -0.012, 0), Eigen::Vector3d(0.012, 0.012, 0.04)),
+      "galvanized_steel",
+      {},
+      {}};
   s.walls.push_back(box);
-  WallSettings paddle{"paddle", make_plane(Eigen::Vector3d(0, 0, 0.003), Eigen::Vector3d::UnitX(), 0.02, 0.006),
-                      "abs_plastic", {}, {}};
+  WallSettings paddle{
+      "paddle",
+      make_plane(Eigen::Vector3d(0, 0, 0.003), Eigen::Vector3d::UnitX(), 0.02, 0.006),
+      "abs_plastic",
+      {},
+      {}};
   WallRotation r;
   r.rpm = 60;
   r.axis = Eigen::Vector3d::UnitZ();

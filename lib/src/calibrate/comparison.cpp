@@ -29,8 +29,9 @@ Comparison compare(const std::vector<Measurement>& measured,
     o.measured = m;
     o.simulated = it->second;
     o.difference = o.simulated.mean - m.value;
-    const double var = m.std * m.std / m.n +
-                       (o.simulated.n > 0 ? o.simulated.std * o.simulated.std / o.simulated.n : 0.0);
+    const double var =
+        m.std * m.std / m.n +
+        (o.simulated.n > 0 ? o.simulated.std * o.simulated.std / o.simulated.n : 0.0);
     o.sigma = std::sqrt(var);
     o.z = o.difference / o.sigma;
     o.rel_error = m.value != 0.0 ? o.difference / std::abs(m.value) : 0.0;

@@ -95,7 +95,8 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       if (!t.paper_spheres && !fx.shape_resolution) all_paper = false;
       const auto counts = paper_preset_counts(regime(t.shape.diameter, t.shape.height));
       std::set<int> s(counts.begin(), counts.end());
-      if (first) common = s;
+      if (first)
+        common = s;
       else {
         std::set<int> x;
         std::set_intersection(common.begin(), common.end(), s.begin(), s.end(),
@@ -141,7 +142,8 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       c.discrete = true;
       const auto cur = fx.rolling_model.value_or(dem::RollingModel::kStandard);
       c.baseline = static_cast<double>(static_cast<int>(cur));
-      for (auto m : {dem::RollingModel::kStandard, dem::RollingModel::kCdt, dem::RollingModel::kEpsd})
+      for (auto m :
+           {dem::RollingModel::kStandard, dem::RollingModel::kCdt, dem::RollingModel::kEpsd})
         if (m != cur) {
           c.levels.push_back(static_cast<int>(m));
           c.level_names.push_back(std::string("rolling_model=") + dem::to_string(m));
@@ -167,7 +169,9 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       c.baseline = 0;
       c.levels = {1};
       c.level_names = {"size_distribution on"};
-      c.apply = [](const ParticleModel& m, double) { return with(m, "effects.size_distribution", "on"); };
+      c.apply = [](const ParticleModel& m, double) {
+        return with(m, "effects.size_distribution", "on");
+      };
       out.push_back(c);
     } else {
       skip("size_distribution", "already on; its fractions are fixed by the model file");

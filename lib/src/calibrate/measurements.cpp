@@ -11,7 +11,9 @@
 
 namespace clumpkit {
 
-std::string Measurement::setting_text() const { return format_settings(setting); }
+std::string Measurement::setting_text() const {
+  return format_settings(setting);
+}
 
 std::string Measurement::key() const {
   return rig + "|" + sample + "|" + setting_text() + "|" + quantity;
@@ -65,8 +67,8 @@ double parse_number(const std::string& s, const std::string& where, const std::s
 }  // namespace
 
 std::vector<Measurement> parse_measurements(const std::string& text, const std::string& name) {
-  static const char* required[] = {"rig", "sample", "setting", "quantity",
-                                   "value", "std", "n", "unit"};
+  static const char* required[] = {"rig",   "sample", "setting", "quantity",
+                                   "value", "std",    "n",       "unit"};
   std::istringstream in(text);
   std::string line;
   int lineno = 0;
@@ -105,20 +107,21 @@ std::vector<Measurement> parse_measurements(const std::string& text, const std::
     m.sample = cell("sample");
     bool sample_ok = false;
     for (const auto& s : known_samples()) sample_ok |= s == m.sample;
-    if (!sample_ok) throw InputError(where, "sample", "unknown sample '" + m.sample + "' (known: A, B, C, mix)");
+    if (!sample_ok)
+      throw InputError(where, "sample", "unknown sample '" + m.sample + "' (known: A, B, C, mix)");
     m.setting = parse_settings(rig, cell("setting"), where, "setting");
     m.quantity = cell("quantity");
     const QuantityInfo* q = rig.quantity(m.quantity);
     if (!q) {
       std::string known;
       for (const auto& k : rig.quantities) known += (known.empty() ? "" : ", ") + k.name;
-      throw InputError(where, "quantity",
-                       "rig '" + m.rig + "' does not measure '" + m.quantity + "' (known: " + known + ")");
+      throw InputError(
+          where, "quantity",
+          "rig '" + m.rig + "' does not measure '" + m.quantity + "' (known: " + known + ")");
     }
     std::string unit = cell("unit");
     if (unit == "-" || unit == "") unit = q->dimension == Dimension::Dimensionless ? "1" : unit;
-    if (unit.empty())
-      throw InputError(where, "unit", "missing (expected " + q->unit + ")");
+    if (unit.empty()) throw InputError(where, "unit", "missing (expected " + q->unit + ")");
     // A compatible unit is converted to the canonical one ("g" -> "kg"); another dimension is an
     // error.
     const double factor = unit_factor(unit, q->dimension, where, "unit") /
@@ -127,26 +130,29 @@ std::vector<Measurement> parse_measurements(const std::string& text, const std::
     // Finite as written can overflow in the canonical unit (1e307 rad in degrees).
     const auto in_range = [&](double v, const char* field) {
       if (!std::isfinite(v))
-        throw InputError(where, field, "'" + cell(field) + " " + unit + "' is out of range in " + m.unit);
+        throw InputError(where, field,
+                         "'" + cell(field) + " " + unit + "' is out of range in " + m.unit);
       return v;
     };
     m.value = in_range(parse_number(cell("value"), where, "value") * factor, "value");
     const std::string std_text = cell("std");
     if (std_text.empty())
-      throw InputError(where, "std", "missing: the standard deviation of the repeats is needed to "
-                                     "weigh this measurement");
+      throw InputError(where, "std",
+                       "missing: the standard deviation of the repeats is needed to "
+                       "weigh this measurement");
     m.std = in_range(parse_number(std_text, where, "std") * factor, "std");
     if (m.std <= 0) throw InputError(where, "std", "must be positive (got " + std_text + ")");
     const double n = parse_number(cell("n"), where, "n");
     if (n < 1 || n != std::floor(n) || n > 1e6)
-      throw InputError(where, "n", "must be a whole number of repeats >= 1 (got " + cell("n") + ")");
+      throw InputError(where, "n",
+                       "must be a whole number of repeats >= 1 (got " + cell("n") + ")");
     m.n = static_cast<int>(n);
     if (q->dimension != Dimension::Angle && m.value < 0)
       throw InputError(where, "value", "must not be negative");
     if (auto it = seen.find(m.key()); it != seen.end())
-      throw InputError(where, "", "duplicate of line " + std::to_string(it->second) + " (" +
-                                      m.rig + ", " + m.sample + ", '" + m.setting_text() + "', " +
-                                      m.quantity + ")");
+      throw InputError(where, "",
+                       "duplicate of line " + std::to_string(it->second) + " (" + m.rig + ", " +
+                           m.sample + ", '" + m.setting_text() + "', " + m.quantity + ")");
     seen[m.key()] = lineno;
     out.push_back(std::move(m));
   }

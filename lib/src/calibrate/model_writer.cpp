@@ -27,7 +27,8 @@ std::string format_model(const ParticleModel& m, const fs::path& target, const s
   s += "\n\n[model]\n";
   s += fmt::format("name = \"{}\"\n", m.name);
   if (!m.description.empty()) s += fmt::format("description = \"{}\"\n", m.description);
-  if (!m.materials_path.empty()) s += fmt::format("materials = \"{}\"\n", rel(m.materials_path, target));
+  if (!m.materials_path.empty())
+    s += fmt::format("materials = \"{}\"\n", rel(m.materials_path, target));
   s += fmt::format("mass_basis = \"{}\"\n", to_string(m.mass_basis));
   for (const auto& t : m.types) {
     s += "\n[[types]]\n";
@@ -40,14 +41,18 @@ std::string format_model(const ParticleModel& m, const fs::path& target, const s
     if (t.given_mass) s += fmt::format("mass = \"{:.10g} kg\"\n", *t.given_mass);
   }
   const ModelEffects& e = m.effects;
-  s += "\n# Contact-law effects that are ON; an effect not listed is absent (SPEC §8).\n[effects]\n";
-  if (e.particle_friction) s += fmt::format("particle_friction = {{ value = {:.10g} }}\n", *e.particle_friction);
+  s +=
+      "\n# Contact-law effects that are ON; an effect not listed is absent (SPEC §8).\n[effects]\n";
+  if (e.particle_friction)
+    s += fmt::format("particle_friction = {{ value = {:.10g} }}\n", *e.particle_friction);
   if (e.size_distribution) s += "size_distribution = true\n";
   if (e.rolling_friction) s += partners("rolling_friction", *e.rolling_friction);
   if (e.wall_friction) s += partners("wall_friction", *e.wall_friction);
   if (e.restitution) s += partners("restitution", *e.restitution);
-  if (e.cohesion) s += fmt::format("\n[effects.cohesion]\nenergy_density = \"{:.10g} J/m^3\"\n", *e.cohesion);
-  if (e.shape_resolution) s += fmt::format("\n[effects.shape_resolution]\nspheres = {}\n", *e.shape_resolution);
+  if (e.cohesion)
+    s += fmt::format("\n[effects.cohesion]\nenergy_density = \"{:.10g} J/m^3\"\n", *e.cohesion);
+  if (e.shape_resolution)
+    s += fmt::format("\n[effects.shape_resolution]\nspheres = {}\n", *e.shape_resolution);
   if (e.rolling_model)
     s += fmt::format("\n[effects.rolling_model]\nmodel = \"{}\"\nviscous_damping = {:.10g}\n",
                      dem::to_string(*e.rolling_model), e.epsd_damping);

@@ -18,7 +18,8 @@ namespace fs = std::filesystem;
 namespace {
 std::string temp_name(const fs::path& path) {
   static thread_local std::mt19937_64 rng{std::random_device{}()};
-  return path.string() + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rng() % 1000000);
+  return path.string() + ".tmp" + std::to_string(::getpid()) + "_" +
+         std::to_string(rng() % 1000000);
 }
 }  // namespace
 

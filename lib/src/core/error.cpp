@@ -35,7 +35,9 @@ std::string compose(const std::string& where, const std::string& field, const st
 }  // namespace
 
 InputError::InputError(std::string where, std::string field, const std::string& what)
-    : std::runtime_error(compose(where, field, what)), where_(std::move(where)),
-      field_(std::move(field)), message_(what) {}
+    : std::runtime_error(compose(where, field, what)),
+      where_(std::move(where)),
+      field_(std::move(field)),
+      message_(what) {}
 
 }  // namespace clumpkit

@@ -11,7 +11,9 @@ std::pair<std::string, std::string> MaterialLibrary::key(const std::string& a,
   return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
 }
 
-void MaterialLibrary::add(const Material& m) { materials_[m.name] = m; }
+void MaterialLibrary::add(const Material& m) {
+  materials_[m.name] = m;
+}
 
 void MaterialLibrary::set_interaction(const std::string& a, const std::string& b,
                                       const Interaction& i) {

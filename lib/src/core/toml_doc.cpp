@@ -1,8 +1,8 @@
 #include "clumpkit/core/toml_doc.hpp"
 
+#include <toml++/toml.h>
 #include <cmath>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
@@ -57,12 +57,15 @@ const void* TomlDoc::find(const std::string& key) const {
   return node;
 }
 
-bool TomlDoc::has(const std::string& key) const { return find(key) != nullptr; }
+bool TomlDoc::has(const std::string& key) const {
+  return find(key) != nullptr;
+}
 
 void TomlDoc::fail(const std::string& key, const std::string& what) const {
   const auto* node = static_cast<const toml::node*>(find(key));
   std::string where = name_;
-  if (node && node->source().begin.line > 0) where += ":" + std::to_string(node->source().begin.line);
+  if (node && node->source().begin.line > 0)
+    where += ":" + std::to_string(node->source().begin.line);
   throw InputError(where, key, what);
 }
 
@@ -98,7 +101,8 @@ std::optional<Eigen::Vector3d> TomlDoc::vector_opt(const std::string& key, Dimen
 
 Eigen::Vector3d TomlDoc::vector(const std::string& key, Dimension d) const {
   auto v = vector_opt(key, d);
-  if (!v) throw InputError(name_, key, "missing (a vector of " + std::string(dimension_name(d)) + ")");
+  if (!v)
+    throw InputError(name_, key, "missing (a vector of " + std::string(dimension_name(d)) + ")");
   return *v;
 }
 

@@ -76,40 +76,68 @@ std::string_view trim(std::string_view s) {
 
 const char* si_unit(Dimension d) {
   switch (d) {
-    case Dimension::Dimensionless: return "1";
-    case Dimension::Length: return "m";
-    case Dimension::Mass: return "kg";
-    case Dimension::Time: return "s";
-    case Dimension::Density: return "kg/m^3";
-    case Dimension::Pressure: return "Pa";
-    case Dimension::Velocity: return "m/s";
-    case Dimension::Angle: return "rad";
-    case Dimension::AngularVelocity: return "rad/s";
-    case Dimension::Volume: return "m^3";
-    case Dimension::Energy: return "J";
-    case Dimension::SurfaceEnergy: return "J/m^2";
-    case Dimension::Acceleration: return "m/s^2";
-    case Dimension::MassFlow: return "kg/s";
+    case Dimension::Dimensionless:
+      return "1";
+    case Dimension::Length:
+      return "m";
+    case Dimension::Mass:
+      return "kg";
+    case Dimension::Time:
+      return "s";
+    case Dimension::Density:
+      return "kg/m^3";
+    case Dimension::Pressure:
+      return "Pa";
+    case Dimension::Velocity:
+      return "m/s";
+    case Dimension::Angle:
+      return "rad";
+    case Dimension::AngularVelocity:
+      return "rad/s";
+    case Dimension::Volume:
+      return "m^3";
+    case Dimension::Energy:
+      return "J";
+    case Dimension::SurfaceEnergy:
+      return "J/m^2";
+    case Dimension::Acceleration:
+      return "m/s^2";
+    case Dimension::MassFlow:
+      return "kg/s";
   }
   return "?";
 }
 
 const char* dimension_name(Dimension d) {
   switch (d) {
-    case Dimension::Dimensionless: return "dimensionless";
-    case Dimension::Length: return "length";
-    case Dimension::Mass: return "mass";
-    case Dimension::Time: return "time";
-    case Dimension::Density: return "density";
-    case Dimension::Pressure: return "pressure";
-    case Dimension::Velocity: return "velocity";
-    case Dimension::Angle: return "angle";
-    case Dimension::AngularVelocity: return "angular velocity";
-    case Dimension::Volume: return "volume";
-    case Dimension::Energy: return "energy";
-    case Dimension::SurfaceEnergy: return "surface energy";
-    case Dimension::Acceleration: return "acceleration";
-    case Dimension::MassFlow: return "mass flow";
+    case Dimension::Dimensionless:
+      return "dimensionless";
+    case Dimension::Length:
+      return "length";
+    case Dimension::Mass:
+      return "mass";
+    case Dimension::Time:
+      return "time";
+    case Dimension::Density:
+      return "density";
+    case Dimension::Pressure:
+      return "pressure";
+    case Dimension::Velocity:
+      return "velocity";
+    case Dimension::Angle:
+      return "angle";
+    case Dimension::AngularVelocity:
+      return "angular velocity";
+    case Dimension::Volume:
+      return "volume";
+    case Dimension::Energy:
+      return "energy";
+    case Dimension::SurfaceEnergy:
+      return "surface energy";
+    case Dimension::Acceleration:
+      return "acceleration";
+    case Dimension::MassFlow:
+      return "mass flow";
   }
   return "?";
 }
@@ -159,21 +187,24 @@ Eigen::Vector3d parse_vector(std::string_view text, Dimension d, const std::stri
   std::string_view s = trim(text);
   Eigen::Vector3d v;
   for (int k = 0; k < 3; ++k) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == ',')) s.remove_prefix(1);
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == ','))
+      s.remove_prefix(1);
     double x = 0.0;
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), x);
     if (ec != std::errc() || ptr == s.data())
       throw InputError(where, field,
                        "'" + std::string(text) + "' is not three numbers and a unit (e.g. \"0 0 " +
                            "-9.81 m/s^2\")");
-    if (!std::isfinite(x)) throw InputError(where, field, "'" + std::string(text) + "' is not finite");
+    if (!std::isfinite(x))
+      throw InputError(where, field, "'" + std::string(text) + "' is not finite");
     v[k] = x;
     s.remove_prefix(static_cast<size_t>(ptr - s.data()));
   }
   s = trim(s);
   if (s.empty() && d != Dimension::Dimensionless)
-    throw InputError(where, field, "'" + std::string(text) + "' has no unit (expected a " +
-                                       dimension_name(d) + " in " + si_unit(d) + ")");
+    throw InputError(where, field,
+                     "'" + std::string(text) + "' has no unit (expected a " + dimension_name(d) +
+                         " in " + si_unit(d) + ")");
   return v * unit_factor(s, d, where, field);
 }
 

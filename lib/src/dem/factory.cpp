@@ -226,6 +226,9 @@ void World::Impl::run_factories() {
                            " could not be placed in its region (" + describe(region) +
                            ") by t = " + fmt_g(time) +
                            " s; the region stays full; lower the rate or enlarge the region");
+    // A factory allowed to fall behind whose region is blocked (nothing fitted in this batch,
+    // e.g. the heap has grown into it) is finished: waiting would never end.
+    if (stuck && !f.s.fail_if_behind && placed == 0) f.status.done = true;
     if ((reached && due >= target) || at_once) f.status.done = true;
   }
 }

@@ -44,11 +44,12 @@ void rotate_momentum(Eigen::Vector3d& pi, int k, double c, double s) {
 inline void half_angle_sincos(double x, double& s, double& c) {
   if (std::abs(x) < 0.01) {
     const double x2 = x * x;
-    s = x * (1.0 - x2 * (1.0 / 6) * (1.0 - x2 * (1.0 / 20) * (1.0 - x2 * (1.0 / 42) *
-                                                                     (1.0 - x2 * (1.0 / 72)))));
-    c = 1.0 - x2 * 0.5 * (1.0 - x2 * (1.0 / 12) *
-                                    (1.0 - x2 * (1.0 / 30) *
-                                               (1.0 - x2 * (1.0 / 56) * (1.0 - x2 * (1.0 / 90)))));
+    s = x * (1.0 - x2 * (1.0 / 6) *
+                       (1.0 - x2 * (1.0 / 20) * (1.0 - x2 * (1.0 / 42) * (1.0 - x2 * (1.0 / 72)))));
+    c = 1.0 -
+        x2 * 0.5 *
+            (1.0 - x2 * (1.0 / 12) *
+                       (1.0 - x2 * (1.0 / 30) * (1.0 - x2 * (1.0 / 56) * (1.0 - x2 * (1.0 / 90)))));
     return;
   }
   s = std::sin(x);
@@ -463,7 +464,7 @@ void World::Impl::compute_forces(double hdt) {
   // sums the forces of its own block of clumps, visiting the contacts in list order (pairs by
   // (i, j), then spheres by index), so every clump's sum is the same sequence of additions for
   // any thread count; thread 0 also adds up the walls' loads and the energies.
-#pragma omp parallel num_threads(threads) if (npc + static_cast<int>(s_r.size()) >= kParallelMin)
+#pragma omp parallel num_threads(threads) if (npc + static_cast <int>(s_r.size()) >= kParallelMin)
   {
 #pragma omp for schedule(static)
     for (int c = 0; c < nc; ++c) {

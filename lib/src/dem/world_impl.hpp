@@ -20,11 +20,11 @@ struct TypeData {
   std::vector<Eigen::Vector3d> offsets;  // sphere centres relative to the centre of mass, m
   std::vector<double> radii;             // m
   double mass = 0.0;                     // kg
-  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // principal moments, kg m^2
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();      // principal moments, kg m^2
   double inv_mass = 0.0;                                  // 1 / mass, for the integrator
   Eigen::Vector3d inv_inertia = Eigen::Vector3d::Zero();  // 1 / principal moments
-  double bound_radius = 0.0;                          // max |offset| + radius, m
-  double volume = 0.0;                                // union volume, m^3
+  double bound_radius = 0.0;                              // max |offset| + radius, m
+  double volume = 0.0;                                    // union volume, m^3
   int material = 0;
 };
 
@@ -80,7 +80,7 @@ struct WallContactData {
   double overlap = 0.0;
   bool closing = false;  // overlap gone, last damping impulse only (contact_law.hpp)
   ContactForce out;
-  Eigen::Vector3d moment = Eigen::Vector3d::Zero();  // (point − clump centre) × force
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();         // (point − clump centre) × force
   Eigen::Vector3d wall_velocity = Eigen::Vector3d::Zero();  // wall material at the point
 };
 
@@ -163,9 +163,9 @@ struct World::Impl {
   bool slot_overflow_warned = false;
   // Per-step scratch of detect_contacts (kept to avoid reallocation).
   std::vector<double> scratch_ratio;
-  std::vector<std::vector<int>> scratch_near;  // per sphere, rebuild_neighbours
+  std::vector<std::vector<int>> scratch_near;                      // per sphere, rebuild_neighbours
   std::vector<std::vector<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
-  std::vector<std::pair<double, int>> scratch_max;          // per thread: overlap ratio, pair
+  std::vector<std::pair<double, int>> scratch_max;  // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
 
   std::vector<FactoryRuntime> factories;

@@ -11,12 +11,17 @@ namespace clumpkit {
 CylinderRegime regime(double d, double h) {
   return h <= d ? CylinderRegime::Flat : CylinderRegime::Tall;
 }
-const char* to_string(CylinderRegime r) { return r == CylinderRegime::Flat ? "flat" : "tall"; }
+const char* to_string(CylinderRegime r) {
+  return r == CylinderRegime::Flat ? "flat" : "tall";
+}
 const char* to_string(PaperRule::Axial a) {
   switch (a) {
-    case PaperRule::Axial::None: return "none";
-    case PaperRule::Axial::Outer: return "outer";
-    case PaperRule::Axial::All: return "all";
+    case PaperRule::Axial::None:
+      return "none";
+    case PaperRule::Axial::Outer:
+      return "outer";
+    case PaperRule::Axial::All:
+      return "all";
   }
   return "?";
 }
@@ -25,8 +30,7 @@ const char* to_string(PaperRule::Radius r) {
 }
 
 std::vector<int> paper_preset_counts(CylinderRegime regime) {
-  return regime == CylinderRegime::Flat ? std::vector<int>{4, 12, 20}
-                                        : std::vector<int>{2, 12, 18};
+  return regime == CylinderRegime::Flat ? std::vector<int>{4, 12, 20} : std::vector<int>{2, 12, 18};
 }
 
 PaperRule paper_preset(CylinderRegime rg, int n) {
@@ -98,8 +102,7 @@ Spheres paper_fill(double d, double h, const PaperRule& rule) {
       out.push_back({Eigen::Vector3d(ring * std::cos(a), ring * std::sin(a), z), r});
     }
     const bool outer = layer == 0 || layer == k - 1;
-    if (rule.axial == PaperRule::Axial::All ||
-        (rule.axial == PaperRule::Axial::Outer && outer))
+    if (rule.axial == PaperRule::Axial::All || (rule.axial == PaperRule::Axial::Outer && outer))
       out.push_back({Eigen::Vector3d(0.0, 0.0, z), r});
   }
   // Snap round-off (cos 90° etc.) so that symmetric fills are exactly symmetric.

@@ -50,7 +50,9 @@ ClumpTemplate make_clump_template(const Spheres& src, double density,
 }
 
 namespace {
-json vec(const Eigen::Vector3d& v) { return json::array({v[0], v[1], v[2]}); }
+json vec(const Eigen::Vector3d& v) {
+  return json::array({v[0], v[1], v[2]});
+}
 json mat(const Eigen::Matrix3d& m) {
   json a = json::array();
   for (int i = 0; i < 3; ++i) a.push_back(json::array({m(i, 0), m(i, 1), m(i, 2)}));
@@ -79,7 +81,8 @@ Eigen::Vector3d read_vec(const json& j, const std::string& where, const std::str
 Eigen::Matrix3d read_mat(const json& j, const std::string& where, const std::string& field) {
   if (!j.is_array() || j.size() != 3) throw InputError(where, field, "expected a 3x3 array");
   Eigen::Matrix3d m;
-  for (int i = 0; i < 3; ++i) m.row(i) = read_vec(j[i], where, field + "[" + std::to_string(i) + "]");
+  for (int i = 0; i < 3; ++i)
+    m.row(i) = read_vec(j[i], where, field + "[" + std::to_string(i) + "]");
   return m;
 }
 }  // namespace
@@ -137,7 +140,8 @@ ClumpTemplate clump_from_json(const json& j, const std::string& where) {
   validate_spheres(c.spheres, where);
   const json& mp = member(j, "mass_properties", where, "");
   MassProperties& m = c.mass;
-  m.density = num(member(mp, "density", where, "mass_properties"), where, "mass_properties.density");
+  m.density =
+      num(member(mp, "density", where, "mass_properties"), where, "mass_properties.density");
   m.volume = num(member(mp, "volume", where, "mass_properties"), where, "mass_properties.volume");
   m.mass = num(member(mp, "mass", where, "mass_properties"), where, "mass_properties.mass");
   if (m.density <= 0) throw InputError(where, "mass_properties.density", "must be positive");

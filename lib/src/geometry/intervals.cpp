@@ -33,8 +33,14 @@ IntervalList combine(const IntervalList& a, const IntervalList& b, Keep keep) {
     const double ta = i < 2 * a.size() ? (i % 2 ? a[i / 2].t1 : a[i / 2].t0) : 1e300;
     const double tb = j < 2 * b.size() ? (j % 2 ? b[j / 2].t1 : b[j / 2].t0) : 1e300;
     const double t = std::min(ta, tb);
-    if (ta == t) { in_a = !in_a; ++i; }
-    if (tb == t) { in_b = !in_b; ++j; }
+    if (ta == t) {
+      in_a = !in_a;
+      ++i;
+    }
+    if (tb == t) {
+      in_b = !in_b;
+      ++j;
+    }
     const bool now = keep(in_a, in_b);
     if (now && !open) {
       start = t;

@@ -122,7 +122,8 @@ std::vector<std::vector<Moments>> integrate_rays(const Eigen::AlignedBox3d& box_
             origin[v] = pv;
             for (auto& c : ch) c.clear();
             channels(origin, axis, ch);
-            for (int c = 0; c < nchannels; ++c) accumulate_moments(ch[c], axis, pu, pv, area, rows[i][c]);
+            for (int c = 0; c < nchannels; ++c)
+              accumulate_moments(ch[c], axis, pu, pv, area, rows[i][c]);
           }
         }
       }

@@ -24,8 +24,7 @@ void validate_spheres(const Spheres& spheres, const std::string& where) {
     if (!s.center.allFinite() || !std::isfinite(s.radius))
       throw InputError(where, field, "coordinate or radius is not finite");
     if (s.radius <= 0.0)
-      throw InputError(where, field,
-                       "radius " + std::to_string(s.radius) + " m is not positive");
+      throw InputError(where, field, "radius " + std::to_string(s.radius) + " m is not positive");
   }
 }
 

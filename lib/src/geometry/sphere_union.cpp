@@ -14,7 +14,8 @@ SphereUnion::SphereUnion(Spheres spheres) : spheres_(std::move(spheres)) {
     ord.resize(spheres_.size());
     for (size_t i = 0; i < ord.size(); ++i) ord[i] = static_cast<int>(i);
     std::sort(ord.begin(), ord.end(), [&](int a, int b) {
-      return spheres_[a].center[u] - spheres_[a].radius < spheres_[b].center[u] - spheres_[b].radius;
+      return spheres_[a].center[u] - spheres_[a].radius <
+             spheres_[b].center[u] - spheres_[b].radius;
     });
     lo_[axis].resize(ord.size());
     for (size_t i = 0; i < ord.size(); ++i)

@@ -4,8 +4,8 @@
 #include <assimp/scene.h>
 
 #include <assimp/Importer.hpp>
-#include <cmath>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <set>
@@ -132,8 +132,8 @@ void check_ply_header(const fs::path& path, const std::string& where) {
     if (word == "property") {
       // An unknown type made assimp abort() later (found by fuzzing): types are checked here.
       static const std::set<std::string> types = {
-          "char",  "uchar", "short",  "ushort", "int",     "uint",    "float",   "double",
-          "int8",  "uint8", "int16",  "uint16", "int32",   "uint32",  "float32", "float64"};
+          "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+          "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
       std::istringstream words(line);
       std::string p, t1, t2, t3;
       words >> p >> t1 >> t2 >> t3;
@@ -216,8 +216,7 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   // No assimp post-processing: its steps (Triangulate, PreTransformVertices, even the structure
   // validation) abort() on corrupt scenes (found by fuzzing). Polygons are fanned here and every
   // index is checked by validate_mesh; the formats read here have no node transforms.
-  const aiScene* scene =
-      importer.ReadFile(path.string(), 0);
+  const aiScene* scene = importer.ReadFile(path.string(), 0);
   if (!scene) {
     throw InputError(
         where, "",
@@ -253,8 +252,8 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   std::size_t collapsed = 0;
   const std::size_t welded = weld_vertices(mesh, opt.weld_tolerance * diag, &collapsed);
   if (mesh.triangles.empty())  // every triangle collapsed (found by fuzzing: accepted as a wall)
-    throw InputError(where, "", "empty mesh (all " + std::to_string(collapsed) +
-                                    " triangles are degenerate)");
+    throw InputError(where, "",
+                     "empty mesh (all " + std::to_string(collapsed) + " triangles are degenerate)");
 
   MeshValidateOptions vopt;
   vopt.check_self_intersections = opt.check_self_intersections;

@@ -4,8 +4,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -22,7 +22,9 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop.store(true); }
+void on_signal(int) {
+  g_stop.store(true);
+}
 
 bool inside(const dem::Region& r, const Eigen::Vector3d& p) {
   if (const auto* b = std::get_if<dem::BoxRegion>(&r))
@@ -41,10 +43,10 @@ std::string duration(double s) {
 
 // Runner bookkeeping that must survive a restart, beside the World's own checkpoint.
 struct RunState {
-  long frame = 0;            // next output frame index
+  long frame = 0;                 // next output frame index
   std::vector<std::string> rows;  // series.csv rows so far
   std::vector<std::pair<double, std::string>> particle_frames, wall_frames;
-  std::string checkpoint;    // file name of the latest complete checkpoint
+  std::string checkpoint;     // file name of the latest complete checkpoint
   double wall_seconds = 0.0;  // accumulated over sessions
 };
 
@@ -240,7 +242,8 @@ RunSummary resume_run(const fs::path& folder, const fs::path& data_dir, bool pro
   world.load_checkpoint(folder / st.checkpoint);
   st.frame = state.at("frame").get<long>();
   st.rows = state.at("rows").get<std::vector<std::string>>();
-  st.particle_frames = state.at("particle_frames").get<std::vector<std::pair<double, std::string>>>();
+  st.particle_frames =
+      state.at("particle_frames").get<std::vector<std::pair<double, std::string>>>();
   st.wall_frames = state.at("wall_frames").get<std::vector<std::pair<double, std::string>>>();
   st.wall_seconds = state.value("wall_seconds", 0.0);
   if (progress)

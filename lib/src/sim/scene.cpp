@@ -108,8 +108,8 @@ dem::WallSettings parse_wall(const TomlDoc& doc, const std::string& key, const f
   const std::string m = key + ".motion";
   if (auto v = doc.vector_opt(m + ".velocity", Dimension::Velocity)) {
     const double start = doc.quantity_opt(m + ".start", Dimension::Time).value_or(0.0);
-    const double stop =
-        doc.quantity_opt(m + ".stop", Dimension::Time).value_or(std::numeric_limits<double>::infinity());
+    const double stop = doc.quantity_opt(m + ".stop", Dimension::Time)
+                            .value_or(std::numeric_limits<double>::infinity());
     if (stop <= start) doc.fail(m + ".stop", "must be after start");
     dem::VelocityProfile p;
     // Step profile: at rest until start, moving until stop (short ramps of 1 ms keep it piecewise
@@ -128,9 +128,11 @@ dem::WallSettings parse_wall(const TomlDoc& doc, const std::string& key, const f
   if (auto rpm = doc.number_opt(m + ".rpm")) {
     dem::WallRotation r;
     r.rpm = *rpm;
-    r.axis = doc.vector_opt(m + ".axis", Dimension::Dimensionless).value_or(Eigen::Vector3d::UnitZ());
+    r.axis =
+        doc.vector_opt(m + ".axis", Dimension::Dimensionless).value_or(Eigen::Vector3d::UnitZ());
     if (r.axis.norm() == 0) doc.fail(m + ".axis", "must not be zero");
-    r.axis_point = doc.vector_opt(m + ".axis_point", Dimension::Length).value_or(Eigen::Vector3d::Zero());
+    r.axis_point =
+        doc.vector_opt(m + ".axis_point", Dimension::Length).value_or(Eigen::Vector3d::Zero());
     r.start_time = doc.quantity_opt(m + ".start", Dimension::Time).value_or(0.0);
     w.motion.rotation = r;
   }
@@ -151,12 +153,13 @@ dem::FactorySettings parse_factory(const TomlDoc& doc, const std::string& key) {
     doc.require_range(key + ".mass", *f.mass, 0.0, 1e6, true);
   }
   if (doc.has(key + ".rate")) {
-    f.rate = has_count ? doc.number(key + ".rate")
-                       : doc.quantity(key + ".rate", Dimension::MassFlow);
+    f.rate =
+        has_count ? doc.number(key + ".rate") : doc.quantity(key + ".rate", Dimension::MassFlow);
     doc.require_range(key + ".rate", f.rate, 0.0, 1e9, true);
   }
   f.start_time = doc.quantity_opt(key + ".start", Dimension::Time).value_or(0.0);
-  f.velocity = doc.vector_opt(key + ".velocity", Dimension::Velocity).value_or(Eigen::Vector3d::Zero());
+  f.velocity =
+      doc.vector_opt(key + ".velocity", Dimension::Velocity).value_or(Eigen::Vector3d::Zero());
   f.random_orientation = doc.boolean_opt(key + ".random_orientation").value_or(true);
   const size_t n = doc.array_size(key + ".mixture");
   if (n == 0) doc.fail(key + ".mixture", "missing: list of {clump = NAME, fraction = F}");

@@ -25,8 +25,8 @@ struct ObservableComparison {
   double difference = 0.0;  ///< simulated - measured, canonical unit
   double sigma = 0.0;       ///< combined standard error
   double z = 0.0;
-  double rel_error = 0.0;   ///< difference / |measured|
-  bool pass = false;        ///< |z| <= 2
+  double rel_error = 0.0;  ///< difference / |measured|
+  bool pass = false;       ///< |z| <= 2
 };
 
 struct Comparison {

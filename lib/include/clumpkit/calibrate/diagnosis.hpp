@@ -8,8 +8,8 @@
 /// simulated at each level.
 ///
 /// A verdict is given only when the baseline is inconsistent with the data (chi2 p-value below
-/// `p_inconsistent`) and the best effect improves the BIC by at least `min_delta_bic`; otherwise the
-/// report says that the model is consistent with the data.
+/// `p_inconsistent`) and the best effect improves the BIC by at least `min_delta_bic`; otherwise
+/// the report says that the model is consistent with the data.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -30,21 +30,21 @@ struct DiagnoseOptions {
   int refine_top = 3;                ///< how many leading candidates are refined
   double min_delta_bic = 6.0;        ///< "strong" evidence (Kass & Raftery)
   double p_inconsistent = 0.01;
-  bool suggest = true;               ///< simulate unmeasured settings to suggest a measurement
-  int suggest_max = 4;               ///< at most this many settings tried
+  bool suggest = true;  ///< simulate unmeasured settings to suggest a measurement
+  int suggest_max = 4;  ///< at most this many settings tried
   std::function<void(const std::string&)> progress;
 };
 
 struct CandidateResult {
   EffectCandidate candidate;
-  double fitted = 0.0;          ///< parameter value (candidate.unit)
-  double fitted_std = 0.0;      ///< 1-sigma uncertainty from the fit's curvature (0: discrete)
-  Comparison comparison;        ///< against the data, from a real simulation at `fitted`
-  double delta_chi2 = 0.0;      ///< baseline chi2 - this chi2
+  double fitted = 0.0;      ///< parameter value (candidate.unit)
+  double fitted_std = 0.0;  ///< 1-sigma uncertainty from the fit's curvature (0: discrete)
+  Comparison comparison;    ///< against the data, from a real simulation at `fitted`
+  double delta_chi2 = 0.0;  ///< baseline chi2 - this chi2
   double bic = 0.0;
-  bool plausible = true;        ///< fitted value inside the physical range, not pinned at a bound
+  bool plausible = true;  ///< fitted value inside the physical range, not pinned at a bound
   bool at_bound = false;
-  double weight = 0.0;          ///< posterior weight among baseline + candidates (BIC)
+  double weight = 0.0;  ///< posterior weight among baseline + candidates (BIC)
 };
 
 struct Suggestion {
@@ -56,17 +56,17 @@ struct Suggestion {
 struct Diagnosis {
   Comparison baseline;
   double baseline_bic = 0.0;
-  double baseline_p = 1.0;  ///< chi2 survival probability of the baseline
+  double baseline_p = 1.0;                  ///< chi2 survival probability of the baseline
   std::vector<CandidateResult> candidates;  ///< best first
   std::vector<std::string> skipped;         ///< effects not tried, with the reason
-  bool consistent = true;  ///< no verdict: the baseline explains the data
-  std::string verdict;     ///< the winning effect, empty when consistent
-  double confidence = 0.0; ///< posterior weight of the verdict (or of the baseline)
-  std::vector<std::string> drivers;          ///< observables that drive the verdict
-  std::vector<std::string> indistinguishable; ///< effects within 2 BIC units of the best
-  std::vector<Suggestion> suggestions;       ///< best first
-  long simulations = 0;  ///< rig runs made (not served by the cache)
-  std::string summary() const;  ///< the verdict in words
+  bool consistent = true;                   ///< no verdict: the baseline explains the data
+  std::string verdict;                      ///< the winning effect, empty when consistent
+  double confidence = 0.0;           ///< posterior weight of the verdict (or of the baseline)
+  std::vector<std::string> drivers;  ///< observables that drive the verdict
+  std::vector<std::string> indistinguishable;  ///< effects within 2 BIC units of the best
+  std::vector<Suggestion> suggestions;         ///< best first
+  long simulations = 0;                        ///< rig runs made (not served by the cache)
+  std::string summary() const;                 ///< the verdict in words
 };
 
 Diagnosis diagnose(const ParticleModel& baseline, const std::vector<Measurement>& measurements,

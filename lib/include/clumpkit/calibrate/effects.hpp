@@ -11,13 +11,13 @@
 namespace clumpkit::calibrate {
 
 struct EffectCandidate {
-  std::string effect;     ///< SPEC §8 id
-  std::string parameter;  ///< what is fitted, e.g. "mu_r (all pairs)"
-  std::string unit;       ///< "1", "J/m^3", "spheres"
+  std::string effect;         ///< SPEC §8 id
+  std::string parameter;      ///< what is fitted, e.g. "mu_r (all pairs)"
+  std::string unit;           ///< "1", "J/m^3", "spheres"
   double lo = 0.0, hi = 1.0;  ///< plausible physical range
-  double baseline = 0.0;  ///< the parameter value equivalent to the baseline model
-  double probe = 0.0;     ///< the perturbation used for the local sensitivity
-  bool discrete = false;  ///< levels instead of a continuous fit
+  double baseline = 0.0;      ///< the parameter value equivalent to the baseline model
+  double probe = 0.0;         ///< the perturbation used for the local sensitivity
+  bool discrete = false;      ///< levels instead of a continuous fit
   std::vector<double> levels;
   std::vector<std::string> level_names;
   /// The baseline model with this effect set to `value`.

@@ -10,15 +10,15 @@
 namespace clumpkit {
 
 struct Measurement {
-  std::string rig;       ///< a rig of rig_catalogue()
-  std::string sample;    ///< "A", "B", "C" or "mix"
+  std::string rig;                             ///< a rig of rig_catalogue()
+  std::string sample;                          ///< "A", "B", "C" or "mix"
   std::map<std::string, std::string> setting;  ///< normalised key=value pairs
-  std::string quantity;  ///< a quantity of the rig
-  double value = 0.0;    ///< in the quantity's canonical unit (deg, kg/m^3, kg, 1, kg/s)
-  double std = 0.0;      ///< standard deviation of the repeats, same unit, > 0
-  int n = 1;             ///< number of repeats, >= 1
-  std::string unit;      ///< canonical unit (the file's unit converted if compatible)
-  int line = 0;          ///< line in the file, for messages
+  std::string quantity;                        ///< a quantity of the rig
+  double value = 0.0;  ///< in the quantity's canonical unit (deg, kg/m^3, kg, 1, kg/s)
+  double std = 0.0;    ///< standard deviation of the repeats, same unit, > 0
+  int n = 1;           ///< number of repeats, >= 1
+  std::string unit;    ///< canonical unit (the file's unit converted if compatible)
+  int line = 0;        ///< line in the file, for messages
   /// Key identifying the observable: rig|sample|setting|quantity.
   std::string key() const;
   std::string setting_text() const;

@@ -9,19 +9,19 @@ namespace clumpkit {
 
 enum class Dimension {
   Dimensionless,
-  Length,          // m
-  Mass,            // kg
-  Time,            // s
-  Density,         // kg/m^3
-  Pressure,        // Pa
-  Velocity,        // m/s
-  Angle,           // rad
-  AngularVelocity, // rad/s
-  Volume,          // m^3
-  Energy,          // J
-  SurfaceEnergy,   // J/m^2
-  Acceleration,    // m/s^2
-  MassFlow,        // kg/s
+  Length,           // m
+  Mass,             // kg
+  Time,             // s
+  Density,          // kg/m^3
+  Pressure,         // Pa
+  Velocity,         // m/s
+  Angle,            // rad
+  AngularVelocity,  // rad/s
+  Volume,           // m^3
+  Energy,           // J
+  SurfaceEnergy,    // J/m^2
+  Acceleration,     // m/s^2
+  MassFlow,         // kg/s
 };
 
 const char* si_unit(Dimension d);

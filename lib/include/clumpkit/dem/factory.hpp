@@ -48,7 +48,7 @@ struct FactorySettings {
   /// With a rate: true = an InputError when the region stays full and the factory falls more
   /// than two batches behind (a scene asked for more than its region can deliver); false = pour
   /// as fast as the region allows, carrying the deficit (the rigs: they need the mass, not the
-  /// rate).
+  /// rate). Such a factory ends when a whole batch fits nothing (its region is blocked).
   bool fail_if_behind = true;
 };
 

@@ -8,9 +8,9 @@ namespace clumpkit {
 
 /// Mass properties of a homogeneous solid, SI units, in the frame the moments were taken in.
 struct MassProperties {
-  double density = 0.0;                                   ///< kg/m^3
-  double volume = 0.0;                                    ///< m^3
-  double mass = 0.0;                                      ///< kg
+  double density = 0.0;                                      ///< kg/m^3
+  double volume = 0.0;                                       ///< m^3
+  double mass = 0.0;                                         ///< kg
   Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();  ///< m
   Eigen::Matrix3d inertia_tensor = Eigen::Matrix3d::Zero();  ///< kg m^2, about the centre of mass
   Eigen::Vector3d principal_moments = Eigen::Vector3d::Zero();  ///< kg m^2, ascending

@@ -41,8 +41,8 @@ struct Estimate {
 Estimate estimate(const std::vector<double>& samples);
 
 /// Per-ray callback: fills `channels[c]` (normalised) for the line through `origin` along `axis`.
-using RayChannels =
-    std::function<void(const Eigen::Vector3d& origin, int axis, std::vector<IntervalList>& channels)>;
+using RayChannels = std::function<void(const Eigen::Vector3d& origin, int axis,
+                                       std::vector<IntervalList>& channels)>;
 
 /// Integrates `nchannels` interval channels over `box`. Returns, per channel, the moments of each
 /// of the 3 * replicates independent estimates (deterministic for a given seed, whatever the

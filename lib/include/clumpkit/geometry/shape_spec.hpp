@@ -8,15 +8,15 @@ namespace clumpkit {
 
 struct ShapeSpec {
   std::string name;
-  std::filesystem::path path;   ///< the shape file it came from (empty if built in code)
+  std::filesystem::path path;  ///< the shape file it came from (empty if built in code)
   enum class Kind { Cylinder, Mesh } kind = Kind::Cylinder;
-  double diameter = 0.0;        ///< m (cylinder)
-  double height = 0.0;          ///< m (cylinder)
-  std::filesystem::path mesh;   ///< mesh file, resolved against the shape file's folder
-  double mesh_scale = 1.0;      ///< factor from mesh file units to metres
+  double diameter = 0.0;       ///< m (cylinder)
+  double height = 0.0;         ///< m (cylinder)
+  std::filesystem::path mesh;  ///< mesh file, resolved against the shape file's folder
+  double mesh_scale = 1.0;     ///< factor from mesh file units to metres
   std::string material = "pill";
-  double density = 0.0;         ///< kg/m^3
-  double mass_fraction = 1.0;   ///< share of the population by mass, (0, 1]
+  double density = 0.0;        ///< kg/m^3
+  double mass_fraction = 1.0;  ///< share of the population by mass, (0, 1]
 };
 
 /// Loads a shape file; throws InputError naming file, line and key on anything missing, negative

@@ -22,7 +22,7 @@ struct RunOptions {
 };
 
 struct RunSummary {
-  double time = 0.0;      ///< simulated time reached, s
+  double time = 0.0;  ///< simulated time reached, s
   long steps = 0;
   double wall_seconds = 0.0;
   std::uint64_t state_hash = 0;

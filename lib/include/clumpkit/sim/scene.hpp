@@ -18,9 +18,10 @@ struct NamedRegion {
 };
 
 struct OutputSettings {
-  double every = 0.0;              ///< s between output frames; 0 = until / 50
-  bool vtk = true;                 ///< particles and walls as VTK PolyData series (ParaView)
-  double checkpoint_minutes = 5.0; ///< wall-clock minutes between checkpoints (also on SIGINT/TERM)
+  double every = 0.0;  ///< s between output frames; 0 = until / 50
+  bool vtk = true;     ///< particles and walls as VTK PolyData series (ParaView)
+  double checkpoint_minutes =
+      5.0;  ///< wall-clock minutes between checkpoints (also on SIGINT/TERM)
 };
 
 struct Scene {
