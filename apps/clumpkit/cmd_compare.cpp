@@ -5,6 +5,7 @@
 
 #include <iostream>
 #include <random>
+#include <set>
 #include <thread>
 
 #include "cli_util.hpp"
@@ -136,9 +137,18 @@ Command setup_compare(CLI::App& parent) {
             RigSimulator sim = make_sim(*a);
             ReportInput rep;
             json chain = json::array();
+            // The versions of a chain share one pooled seed-to-seed spread (comparison.hpp).
+            std::vector<std::map<std::string, SimulatedValue>> simulated;
+            SpreadPool pool;
+            std::set<std::string> pooled_models;
             for (const auto& m : models) {
-              const auto s = simulate_measurements(sim, m, ms, a->scale, a->repeats, a->seed);
-              const Comparison cmp = compare(ms, s);
+              simulated.push_back(
+                  simulate_measurements(sim, m, ms, a->scale, a->repeats, a->seed));
+              if (pooled_models.insert(model_fingerprint(m)).second) pool.add(simulated.back());
+            }
+            for (size_t i = 0; i < models.size(); ++i) {
+              const ParticleModel& m = models[i];
+              const Comparison cmp = compare(ms, pool.pooled(simulated[i]));
               print_comparison(m.name, cmp);
               rep.chain.emplace_back(m.name, cmp);
               json j = comparison_json(cmp);

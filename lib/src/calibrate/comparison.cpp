@@ -19,6 +19,30 @@ SimulatedValue summarize(const std::vector<double>& r) {
   return s;
 }
 
+void SpreadPool::add(const std::map<std::string, SimulatedValue>& values) {
+  for (const auto& [key, v] : values) {
+    if (v.n < 2 || !std::isfinite(v.std)) continue;
+    auto& [sum, dof] = acc_[key];
+    sum += (v.n - 1) * v.std * v.std;
+    dof += v.n - 1;
+  }
+}
+
+std::map<std::string, SimulatedValue> SpreadPool::pooled(
+    std::map<std::string, SimulatedValue> values) const {
+  for (auto& [key, v] : values) {
+    auto it = acc_.find(key);
+    if (it != acc_.end() && it->second.second > 0)
+      v.std = std::sqrt(it->second.first / it->second.second);
+  }
+  return values;
+}
+
+int SpreadPool::dof(const std::string& key) const {
+  auto it = acc_.find(key);
+  return it == acc_.end() ? 0 : it->second.second;
+}
+
 Comparison compare(const std::vector<Measurement>& measured,
                    const std::map<std::string, SimulatedValue>& simulated, int k) {
   Comparison c;

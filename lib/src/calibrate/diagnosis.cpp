@@ -130,8 +130,14 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
   };
+  // The seed-to-seed spread of every observable, pooled over all the variants simulated
+  // (comparison.hpp): the spread of two repeats of one model is too uncertain to weigh by.
+  SpreadPool pool;
+  std::set<std::string> pooled_models;
   auto simulate = [&](const ParticleModel& m) {
-    return simulate_measurements(sim, m, ms, o.scale, o.repeats, o.seed);
+    Values v = simulate_measurements(sim, m, ms, o.scale, o.repeats, o.seed);
+    if (pooled_models.insert(model_fingerprint(m)).second) pool.add(v);
+    return v;
   };
   // Runs that are known in advance are announced together, so a simulator can run them side
   // by side; the results (and so the diagnosis) do not depend on it.
@@ -164,9 +170,6 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   }
   say("baseline model " + base.name);
   const Values s0 = simulate(base);
-  d.baseline = compare(ms, s0, 0);
-  d.baseline_bic = d.baseline.bic;
-  d.baseline_p = chi2_survival(d.baseline.chi2, n);
 
   struct Work {
     EffectCandidate c;
@@ -187,7 +190,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         for (size_t i = 0; i < c.levels.size(); ++i) {
           say(fmt::format("{}: {}", c.effect, c.level_names[i]));
           Values v = simulate(c.apply(base, c.levels[i]));
-          const double chi2 = compare(ms, v, 1).chi2;
+          const double chi2 = compare(ms, pool.pooled(v), 1).chi2;
           if (chi2 < best) {
             best = chi2;
             w.fit = {c.levels[i], chi2, 0.0};
@@ -199,7 +202,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
         w.s.add(c.baseline, s0);
         w.s.add(c.probe, simulate(c.apply(base, c.probe)));
-        w.fit = fit_surrogate(ms, s0, w.s, c.lo, c.hi);
+        w.fit = fit_surrogate(ms, pool.pooled(s0), w.s, c.lo, c.hi);
       }
     } catch (const NumericalError& e) {
       say(fmt::format("{}: not tried: {}", c.effect, e.what()));
@@ -236,7 +239,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         continue;
       }
       w->s.add(w->fit.theta, v);
-      const Fit next = fit_surrogate(ms, s0, w->s, w->c.lo, w->c.hi);
+      const Fit next = fit_surrogate(ms, pool.pooled(s0), w->s, w->c.lo, w->c.hi);
       const bool converged =
           std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
       w->fit = next;
@@ -271,16 +274,25 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         } catch (const NumericalError& e) {
           d.skipped.push_back(w.c.effect + ": the run at its fitted value " +
                               w.c.format(w.fit.theta) + " failed: " + e.what());
+          w.dropped = true;
           continue;
         }
         w.s.add(w.fit.theta, w.at_fit);
       }
+      w.have_at_fit = true;
     }
+  }
+  // All runs are made: every comparison weighs by the final pooled spread.
+  d.baseline = compare(ms, pool.pooled(s0), 0);
+  d.baseline_bic = d.baseline.bic;
+  d.baseline_p = chi2_survival(d.baseline.chi2, n);
+  for (Work& w : work) {
+    if (w.dropped) continue;
     CandidateResult r;
     r.candidate = w.c;
     r.fitted = w.fit.theta;
     r.fitted_std = w.fit.sigma;
-    r.comparison = compare(ms, w.at_fit, 1);
+    r.comparison = compare(ms, pool.pooled(w.at_fit), 1);
     r.delta_chi2 = d.baseline.chi2 - r.comparison.chi2;
     r.bic = r.comparison.chi2 + ln_n;
     const double span = w.c.hi - w.c.lo;
