@@ -139,7 +139,7 @@ Command setup_compare(CLI::App& parent) {
             json chain = json::array();
             // The versions of a chain share one pooled seed-to-seed spread (comparison.hpp).
             std::vector<std::map<std::string, SimulatedValue>> simulated;
-            SpreadPool pool;
+            SpreadPool pool(ms);
             std::set<std::string> pooled_models;
             for (const auto& m : models) {
               simulated.push_back(
@@ -334,12 +334,17 @@ Command setup_synth(CLI::App& parent) {
             const auto s = simulate_measurements(sim, truth, ms, a->scale, a->repeats, seed);
             std::mt19937_64 rng(a->seed);
             for (auto& m : ms) {
-              const double v = s.at(m.key()).mean;
-              m.std = a->noise * std::abs(v);
-              if (m.std <= 0) m.std = a->noise;
-              std::normal_distribution<double> g(0.0, m.std / std::sqrt(static_cast<double>(m.n)));
+              const SimulatedValue& t = s.at(m.key());
+              const double v = t.mean;
+              double lab = a->noise * std::abs(v);
+              if (lab <= 0) lab = a->noise;
+              std::normal_distribution<double> g(0.0, lab / std::sqrt(static_cast<double>(m.n)));
               m.value = v + g(rng);
               if (m.value < 0 && m.unit != "deg") m.value = 0.0;
+              // The truth's mean is itself an estimate from a few seeds: its standard error is
+              // folded into the stated std, so that std / sqrt(n) covers both.
+              const double se_truth = t.n > 1 ? t.std / std::sqrt(static_cast<double>(t.n)) : 0.0;
+              m.std = std::sqrt(lab * lab + m.n * se_truth * se_truth);
             }
             write_file_atomic(
                 a->output, fmt::format("# synthetic: truth model {}, noise {} relative, seed {}, "

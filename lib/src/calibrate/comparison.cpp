@@ -19,10 +19,20 @@ SimulatedValue summarize(const std::vector<double>& r) {
   return s;
 }
 
+SpreadPool::SpreadPool(const std::vector<Measurement>& measurements) {
+  for (const Measurement& m : measurements)
+    family_[m.key()] = m.rig + "|" + m.sample + "|" + m.quantity;
+}
+
+const std::string& SpreadPool::family(const std::string& key) const {
+  auto it = family_.find(key);
+  return it == family_.end() ? key : it->second;
+}
+
 void SpreadPool::add(const std::map<std::string, SimulatedValue>& values) {
   for (const auto& [key, v] : values) {
     if (v.n < 2 || !std::isfinite(v.std)) continue;
-    auto& [sum, dof] = acc_[key];
+    auto& [sum, dof] = acc_[family(key)];
     sum += (v.n - 1) * v.std * v.std;
     dof += v.n - 1;
   }
@@ -31,7 +41,7 @@ void SpreadPool::add(const std::map<std::string, SimulatedValue>& values) {
 std::map<std::string, SimulatedValue> SpreadPool::pooled(
     std::map<std::string, SimulatedValue> values) const {
   for (auto& [key, v] : values) {
-    auto it = acc_.find(key);
+    auto it = acc_.find(family(key));
     if (it != acc_.end() && it->second.second > 0)
       v.std = std::sqrt(it->second.first / it->second.second);
   }
@@ -39,7 +49,7 @@ std::map<std::string, SimulatedValue> SpreadPool::pooled(
 }
 
 int SpreadPool::dof(const std::string& key) const {
-  auto it = acc_.find(key);
+  auto it = acc_.find(family(key));
   return it == acc_.end() ? 0 : it->second.second;
 }
 

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -47,7 +49,12 @@ double gamma_q(double a, double x) {
 
 using Values = std::map<std::string, SimulatedValue>;
 
-// Piecewise-linear response surrogate of one candidate: simulated points (theta, values).
+// Response surrogate of one candidate through its simulated points (theta, values): a line
+// through two points, a least-squares parabola through three or more, continued as a straight
+// line (its tangent) beyond the points. Each point is a mean of a few noisy repeats, so the
+// surrogate smooths rather than interpolates: a piecewise-linear interpolant takes its slope
+// from the two nearest points, and two nearby refinement points give a slope that is mostly
+// seed noise (and with it a fitted uncertainty several times too small).
 struct Surrogate {
   std::vector<std::pair<double, Values>> points;  // sorted by theta
 
@@ -60,15 +67,63 @@ struct Surrogate {
     points.emplace_back(theta, std::move(v));
     std::sort(points.begin(), points.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
+    coef.clear();
   }
   double value(const std::string& key, double theta) const {
-    if (points.size() == 1) return points[0].second.at(key).mean;
-    size_t k = 1;
-    while (k + 1 < points.size() && points[k].first < theta) ++k;
-    const auto& [t0, v0] = points[k - 1];
-    const auto& [t1, v1] = points[k];
-    const double y0 = v0.at(key).mean, y1 = v1.at(key).mean;
-    return y0 + (y1 - y0) * (theta - t0) / (t1 - t0);
+    const Poly& c = poly(key);
+    const double lo = points.front().first, hi = points.back().first;
+    auto at = [&](double t) {
+      const double x = (t - c.mid) / c.half;
+      return c.a + x * (c.b + x * c.c);
+    };
+    auto slope = [&](double t) {
+      const double x = (t - c.mid) / c.half;
+      return (c.b + 2.0 * c.c * x) / c.half;
+    };
+    if (theta < lo) return at(lo) + slope(lo) * (theta - lo);
+    if (theta > hi) return at(hi) + slope(hi) * (theta - hi);
+    return at(theta);
+  }
+
+ private:
+  struct Poly {
+    double mid = 0, half = 1, a = 0, b = 0, c = 0;  ///< a + b x + c x^2, x = (t - mid) / half
+  };
+  mutable std::map<std::string, Poly> coef;
+
+  const Poly& poly(const std::string& key) const {
+    auto it = coef.find(key);
+    if (it != coef.end()) return it->second;
+    Poly p;
+    const size_t n = points.size();
+    p.mid = 0.5 * (points.front().first + points.back().first);
+    p.half = std::max(0.5 * (points.back().first - points.front().first), 1e-300);
+    if (n == 1) {
+      p.a = points[0].second.at(key).mean;
+    } else if (n == 2) {
+      const double y0 = points[0].second.at(key).mean, y1 = points[1].second.at(key).mean;
+      p.a = 0.5 * (y0 + y1);
+      p.b = 0.5 * (y1 - y0);  // x runs from -1 to 1 between the two points
+    } else {
+      // Normal equations of the least-squares parabola in x (well conditioned: |x| <= 1).
+      double S[5] = {0, 0, 0, 0, 0}, T[3] = {0, 0, 0};
+      for (const auto& [t, v] : points) {
+        const double x = (t - p.mid) / p.half, y = v.at(key).mean;
+        double xk = 1.0;
+        for (int k = 0; k < 5; ++k) {
+          if (k < 3) T[k] += xk * y;
+          S[k] += xk;
+          xk *= x;
+        }
+      }
+      Eigen::Matrix3d M;
+      M << S[0], S[1], S[2], S[1], S[2], S[3], S[2], S[3], S[4];
+      const Eigen::Vector3d q = M.ldlt().solve(Eigen::Vector3d(T[0], T[1], T[2]));
+      p.a = q[0];
+      p.b = q[1];
+      p.c = q[2];
+    }
+    return coef.emplace(key, p).first->second;
   }
 };
 
@@ -132,7 +187,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   };
   // The seed-to-seed spread of every observable, pooled over all the variants simulated
   // (comparison.hpp): the spread of two repeats of one model is too uncertain to weigh by.
-  SpreadPool pool;
+  SpreadPool pool(ms);
   std::set<std::string> pooled_models;
   auto simulate = [&](const ParticleModel& m) {
     Values v = simulate_measurements(sim, m, ms, o.scale, o.repeats, o.seed);

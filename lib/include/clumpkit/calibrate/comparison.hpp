@@ -45,22 +45,28 @@ Comparison compare(const std::vector<Measurement>& measured,
                    int fitted_parameters = 0);
 
 /// The seed-to-seed spread of each observable pooled over several simulated models (the versions
-/// of a chain, the variants of a diagnosis): s^2 = sum (n_i - 1) s_i^2 / sum (n_i - 1). Two repeats
-/// of one model give a spread with one degree of freedom, which is often several times too small
-/// and then turns seed noise into a spurious misfit; the spread of the rigs' observables changes
-/// little between nearby models, so pooling estimates it far better.
+/// of a chain, the variants of a diagnosis) and over the settings of one rig quantity (the angle
+/// of repose on three plates): s^2 = sum (n_i - 1) s_i^2 / sum (n_i - 1). Two repeats of one model
+/// give a spread with one degree of freedom, which is often several times too small and then
+/// turns seed noise into a spurious misfit; the scatter of a rig's quantity changes little between
+/// nearby models and settings, so pooling estimates it far better.
 class SpreadPool {
  public:
+  SpreadPool() = default;
+  /// Pools each measurement's observable with the others of its rig, sample and quantity.
+  explicit SpreadPool(const std::vector<Measurement>& measurements);
   /// Adds one model's values (each observable's spread from its repeats). The caller adds each
   /// distinct model once.
   void add(const std::map<std::string, SimulatedValue>& values);
   /// `values` with each spread replaced by the pooled one where the pool knows the observable.
   std::map<std::string, SimulatedValue> pooled(std::map<std::string, SimulatedValue> values) const;
-  /// Degrees of freedom behind the pooled spread of `key` (0: unknown).
+  /// Degrees of freedom behind the pooled spread of observable `key` (0: unknown).
   int dof(const std::string& key) const;
 
  private:
-  std::map<std::string, std::pair<double, int>> acc_;  ///< sum (n-1) s^2, sum (n-1)
+  const std::string& family(const std::string& key) const;
+  std::map<std::string, std::string> family_;          ///< observable key -> pooling family
+  std::map<std::string, std::pair<double, int>> acc_;  ///< per family: sum (n-1) s^2, sum (n-1)
 };
 
 /// Mean and sample standard deviation of repeats.
