@@ -12,6 +12,10 @@ namespace clumpkit::calibrate::fake {
 class FakeSimulator final : public Simulator {
  public:
   double noise_rel = 0.004;  // relative std of one repeat
+  // true: the same seed gives the same noise whatever the model (ideal common random numbers);
+  // false: every model draws its own noise, as a chaotic granular flow does when a parameter
+  // changes a little (the rigs' runs decorrelate quickly).
+  bool common_random_numbers = true;
 
   SimValues simulate(const ParticleModel& model, const SimRequest& r, int repeats,
                      std::uint64_t seed) override {
@@ -49,7 +53,8 @@ class FakeSimulator final : public Simulator {
     }
     SimValues out;
     for (const auto& [q, m] : mean) {
-      std::seed_seq ss{seed, std::hash<std::string>{}(r.key() + q)};
+      const std::string salt = common_random_numbers ? "" : model_fingerprint(model);
+      std::seed_seq ss{seed, std::hash<std::string>{}(r.key() + q + salt)};
       std::mt19937_64 rng(ss);
       std::normal_distribution<double> g(0.0, noise_rel * std::abs(m));
       std::vector<double> v;

@@ -122,6 +122,15 @@ struct Surrogate {
       p.a = q[0];
       p.b = q[1];
       p.c = q[2];
+      // A parabola that turns over between the points is seed noise, not physics (the rigs'
+      // responses to one effect's strength are monotone over such a span): the least-squares
+      // line instead, which cannot trap the fit at a spurious extremum.
+      if ((p.b - 2.0 * p.c) * (p.b + 2.0 * p.c) < 0.0) {
+        const double det = S[0] * S[2] - S[1] * S[1];
+        p.b = (S[0] * T[1] - S[1] * T[0]) / det;
+        p.a = (T[0] - p.b * S[1]) / S[0];
+        p.c = 0.0;
+      }
     }
     return coef.emplace(key, p).first->second;
   }

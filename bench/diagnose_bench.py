@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""Benchmark of the diagnosis loop through the real rigs over the whole effect catalogue (issue 7).
+
+For each hidden effect (and for none), a truth model makes synthetic lab data with
+`clumpkit synth`; `clumpkit diagnose --apply` runs over the whole catalogue (no --effects) from
+a baseline without the effect; `clumpkit compare` shows the chain baseline -> applied model.
+Measurements: the angle of repose on the three plates and the bulk density in the organic-glass
+cup, pill A with 12 spheres (paper rule), Table 1 materials with the pill's Young's modulus
+lowered to --youngs (default 1e7 Pa; the paper's 1.1e8 Pa with --youngs 1.1e8).
+
+Cases (truth vs baseline; every other effect as in Table 1):
+  rolling_friction   mu_r 0.2 on every pair, baseline 0.05 (with none the small heap spreads flat)
+  cohesion           simplified-JKR energy density 2e4 J/m^3 pill-pill, baseline none
+  wall_friction      mu_s pill-wall 0.9 on every wall, baseline 0.3
+  shape_resolution   4 spheres per pill, baseline 12
+  none               truth = baseline (the diagnosis must not give a verdict)
+
+Writes OUT/results.md (a table) and OUT/<case>/ (models, data, JSON, HTML reports); the rig
+results are cached in OUT/cache, shared by the cases, so a second run of the script simulates
+nothing. Prints the wall time per case. Python 3 standard library only.
+
+  python3 bench/diagnose_bench.py --clumpkit build/apps/clumpkit/clumpkit --out diag_bench \\
+      [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+WALLS = ["abs_plastic", "organic_glass", "galvanized_steel"]
+
+
+def model(name, source, materials, extra):
+    """Pill A, 12 spheres, Table 1 effects; `extra` maps effect -> TOML lines replacing it."""
+    lines = ["[model]", f'name = "{name}"', f'materials = "{materials}"',
+             'mass_basis = "sphere_union"', "[[types]]", 'name = "A"',
+             f'shape = "{os.path.join(source, "shapes", "pill_A.toml")}"', "paper_spheres = 12",
+             "[effects]"]
+    tables = []
+    for e in ["restitution", "particle_friction", "wall_friction", "rolling_friction"]:
+        if e in extra:
+            tables += [f"[effects.{e}]"] + extra[e]
+        else:
+            lines.append(f"{e} = true")
+    for e in ["cohesion", "shape_resolution"]:
+        if e in extra:
+            tables += [f"[effects.{e}]"] + extra[e]
+    return "\n".join(lines + tables) + "\n"
+
+
+def per_partner(value, partners):
+    return [f"{p} = {value}" for p in partners]
+
+
+CASES = {
+    "rolling_friction": (
+        {"rolling_friction": per_partner(0.2, ["pill"] + WALLS)},
+        {"rolling_friction": per_partner(0.05, ["pill"] + WALLS)}, 0.2),
+    "cohesion": ({"cohesion": ['energy_density = "2e4 J/m^3"']}, {}, 2e4),
+    "wall_friction": ({"wall_friction": per_partner(0.9, WALLS)},
+                      {"wall_friction": per_partner(0.3, WALLS)}, 0.9),
+    "shape_resolution": ({"shape_resolution": ["spheres = 4"]}, {}, 4),
+    "none": ({}, {}, None),
+}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--clumpkit", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--source", default=os.path.join(os.path.dirname(__file__), ".."))
+    ap.add_argument("--scale", default="tiny")
+    ap.add_argument("--youngs", default="1.0e7", help="pill Young's modulus, Pa")
+    ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--jobs", default="0")
+    ap.add_argument("--noise", default="0.03")
+    a = ap.parse_args()
+    ck, src, out = (os.path.abspath(p) for p in (a.clumpkit, a.source, a.out))
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(src, "shapes", "materials.toml")) as f:
+        mats = f.read()
+    soft = mats.replace('youngs_modulus = "1.100e8 Pa"', f'youngs_modulus = "{a.youngs} Pa"')
+    materials = os.path.join(out, "materials.toml")
+    with open(materials, "w") as f:
+        f.write(soft)
+    common = ["--scale", a.scale, "--cache", os.path.join(out, "cache"), "--jobs", a.jobs]
+    rows = []
+    for case in a.cases.split(","):
+        truth_fx, base_fx, truth_value = CASES[case]
+        d = os.path.join(out, case)
+        os.makedirs(d, exist_ok=True)
+        for name, fx in (("truth", truth_fx), ("base", base_fx)):
+            with open(os.path.join(d, name + ".toml"), "w") as f:
+                f.write(model(f"A12_{name}_{case}" if name == "truth" else "A12_base_" + case,
+                              src, materials, fx))
+        with open(os.path.join(d, "template.csv"), "w") as f:
+            f.write("rig,sample,setting,quantity,value,std,n,unit\n" + "".join(
+                f"angle_of_repose,A,plate={p},angle,30,1,3,deg\n" for p in WALLS) +
+                "bulk_density,A,wall=organic_glass,bulk_density,700,10,3,kg/m^3\n")
+
+        def run(*args):
+            with open(os.path.join(d, "log.txt"), "a") as log:
+                p = subprocess.run([ck, *args], cwd=d, stdout=log, stderr=subprocess.STDOUT)
+            if p.returncode != 0:
+                sys.exit(f"{case}: clumpkit {args[0]} failed ({p.returncode}); see {d}/log.txt")
+
+        t0 = time.time()
+        run("synth", "--model", "truth.toml", "--measurements-template", "template.csv",
+            "--noise", a.noise, "--seed", "7", "--repeats", "4", "-o", "lab.csv", *common)
+        t1 = time.time()
+        run("diagnose", "--model", "base.toml", "--measurements", "lab.csv", "--apply", "-o",
+            "v2.toml", "--json", "diag.json", "--report", "report", *common)
+        t2 = time.time()
+        with open(os.path.join(d, "diag.json")) as f:
+            dj = json.load(f)
+        chain = {}
+        if dj["verdict"]["effect"]:
+            run("compare", "--model", "base.toml", "--model", "v2.toml", "--measurements",
+                "lab.csv", "--json", "cmp.json", *common)
+            with open(os.path.join(d, "cmp.json")) as f:
+                chain = {m["model"]: m["chi2_per_dof"] for m in json.load(f)["chain"]}
+        top = dj["candidates"][0] if dj["candidates"] else None
+        rows.append({
+            "case": case, "truth": truth_value,
+            "verdict": dj["verdict"]["effect"] or "(consistent)",
+            "confidence": dj["verdict"]["confidence"],
+            "top": top["effect"] if top else "-",
+            "fitted": top["fitted"]["value"] if top else None,
+            "fitted_std": top["fitted"]["std"] if top else None,
+            "chi2dof_base": dj.get("baseline", {}).get("chi2_per_dof"),
+            "chi2dof_after": list(chain.values())[-1] if chain else None,
+            "runs": dj["simulations"], "synth_s": t1 - t0, "diagnose_s": t2 - t1,
+            "skipped": dj.get("skipped", [])})
+        r = rows[-1]
+        print(f"{case}: verdict {r['verdict']} (top {r['top']} {r['fitted']} +/- "
+              f"{r['fitted_std']}, truth {truth_value}), chi2/dof {r['chi2dof_base']} -> "
+              f"{r['chi2dof_after']}, {r['runs']} rig runs, synth {r['synth_s']:.0f} s, "
+              f"diagnose {r['diagnose_s']:.0f} s", flush=True)
+        with open(os.path.join(out, "results.json"), "w") as f:
+            json.dump(rows, f, indent=1)
+    with open(os.path.join(out, "results.md"), "w") as f:
+        f.write(f"scale {a.scale}, pill Young's modulus {a.youngs} Pa, noise {a.noise}, "
+                "diagnose over the whole catalogue, 2 repeats, synth 4 repeats\n\n"
+                "| hidden effect | verdict (confidence) | top candidate: fitted ± std | truth | "
+                "χ²/dof baseline → applied | rig runs | diagnose wall time |\n"
+                "|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            fit = (f"{r['top']}: {r['fitted']:.4g} ± {r['fitted_std']:.2g}"
+                   if r["fitted"] is not None else r["top"])
+            after = f"{r['chi2dof_after']:.2f}" if r["chi2dof_after"] is not None else "-"
+            base = f"{r['chi2dof_base']:.2f}" if r["chi2dof_base"] is not None else "-"
+            f.write(f"| {r['case']} | {r['verdict']} ({r['confidence']:.2f}) | {fit} | "
+                    f"{r['truth'] if r['truth'] is not None else '-'} | {base} → {after} | "
+                    f"{r['runs']} | {r['diagnose_s'] / 60:.1f} min |\n")
+    print(f"wrote {os.path.join(out, 'results.md')}")
+
+
+if __name__ == "__main__":
+    main()
