@@ -59,12 +59,20 @@ def main():
     ap.add_argument("--source", required=True, help="the repository (for shapes/)")
     ap.add_argument("--work", required=True, help="scratch folder (emptied first)")
     ap.add_argument("--jobs", default="0", help="rig runs side by side (0 = one per core)")
+    ap.add_argument("--keep-cache", action="store_true",
+                    help="keep WORK/cache from an earlier run (same engine only)")
     a = ap.parse_args()
     a.clumpkit = os.path.abspath(a.clumpkit)
     a.source = os.path.abspath(a.source)
 
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
+    if a.keep_cache and os.path.isdir(os.path.join(a.work, "cache")):
+        for entry in os.listdir(a.work):
+            if entry != "cache":
+                p = os.path.join(a.work, entry)
+                shutil.rmtree(p) if os.path.isdir(p) else os.remove(p)
+    else:
+        shutil.rmtree(a.work, ignore_errors=True)
+        os.makedirs(a.work)
     w = lambda *p: os.path.join(a.work, *p)
     with open(os.path.join(a.source, "shapes", "materials.toml")) as f:
         materials = f.read()
