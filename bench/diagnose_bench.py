@@ -20,7 +20,7 @@ results are cached in OUT/cache, shared by the cases, so a second run of the scr
 nothing. Prints the wall time per case. Python 3 standard library only.
 
   python3 bench/diagnose_bench.py --clumpkit build/apps/clumpkit/clumpkit --out diag_bench \\
-      [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0]
+      [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0] [--no-suggest]
 """
 import argparse
 import json
@@ -76,6 +76,8 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--jobs", default="0")
     ap.add_argument("--noise", default="0.03")
+    ap.add_argument("--no-suggest", action="store_true",
+                    help="skip the next-measurement suggestion (its trial runs)")
     a = ap.parse_args()
     ck, src, out = (os.path.abspath(p) for p in (a.clumpkit, a.source, a.out))
     os.makedirs(out, exist_ok=True)
@@ -111,7 +113,8 @@ def main():
             "--noise", a.noise, "--seed", "7", "--repeats", "4", "-o", "lab.csv", *common)
         t1 = time.time()
         run("diagnose", "--model", "base.toml", "--measurements", "lab.csv", "--apply", "-o",
-            "v2.toml", "--json", "diag.json", "--report", "report", *common)
+            "v2.toml", "--json", "diag.json", "--report", "report", *common,
+            *(["--no-suggest"] if a.no_suggest else []))
         t2 = time.time()
         with open(os.path.join(d, "diag.json")) as f:
             dj = json.load(f)
