@@ -1,6 +1,7 @@
 // Loading meshes in every supported format, welding, scaling, orientation and bad input.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -101,6 +102,78 @@ TEST_F(MeshFiles, EveryFormatLoadsTheSameClosedCube) {
     EXPECT_NEAR(polyhedron_moments(m).m0, 1.0, 1e-12);
     EXPECT_NEAR(r.area, 6.0, 1e-12);
   }
+}
+
+// The cube as binary PLY in either byte order (float vertices, uchar/int face lists).
+std::string cube_binary_ply(bool big_endian) {
+  const TriangleMesh b = box_mesh(Eigen::Vector3d(1, 1, 1));
+  std::string t = std::string("ply\nformat ") +
+                  (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                  " 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float "
+                  "z\nelement face 12\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto put = [&](const void* p, std::size_t n) {
+    const char* c = static_cast<const char*>(p);
+    for (std::size_t k = 0; k < n; ++k) t += c[big_endian ? n - 1 - k : k];  // host: little
+  };
+  for (const auto& v : b.vertices)
+    for (int k = 0; k < 3; ++k) {
+      const float x = static_cast<float>(v[k]);
+      put(&x, 4);
+    }
+  for (const auto& f : b.triangles) {
+    t += '\3';
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t i = f[k];
+      put(&i, 4);
+    }
+  }
+  return t;
+}
+
+TEST_F(MeshFiles, BinaryPlyLoadsInBothByteOrders) {
+  for (const bool big : {false, true}) {
+    SCOPED_TRACE(big ? "big endian" : "little endian");
+    MeshReport r;
+    const TriangleMesh m = load_mesh(write("c.ply", cube_binary_ply(big)), MeshLoadOptions{}, &r);
+    EXPECT_EQ(m.triangles.size(), 12u);
+    EXPECT_TRUE(r.closed_solid()) << r.defects();
+    EXPECT_NEAR(polyhedron_moments(m).m0, 1.0, 1e-12);
+  }
+}
+
+// assimp reserves memory by the counts it reads: PLY bodies whose counts do not match their
+// contents are refused before assimp sees them, naming the line (ASCII) or byte (binary).
+TEST_F(MeshFiles, PlyCountsThatDoNotMatchTheBodyAreRefusedWithTheirPlace) {
+  const auto refused = [&](const std::string& name, const std::string& text,
+                           const std::string& expected) {
+    SCOPED_TRACE(name);
+    try {
+      load_mesh(write(name, text));
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  std::string ascii = cube_ply();
+  // The fuzzer's input: a face list count far beyond its uchar type (assimp asked for 34 GB).
+  std::string huge = ascii;
+  huge.replace(huge.rfind("\n3 ") + 1, 1, "3429496729");
+  refused("huge.ply", huge, "line 29");  // 9 header lines, 8 vertices, 12 faces
+  std::string short_list = ascii;
+  short_list.replace(short_list.rfind("\n3 ") + 1, 1, "9");
+  refused("short_list.ply", short_list, "announces 9 values");
+  refused("missing_faces.ply", ascii.substr(0, ascii.rfind("\n3 ") + 1), "11 of the 12 'face'");
+  std::string word = ascii;
+  word.replace(word.find("end_header\n") + 11, 1, "x");
+  refused("word.ply", word, "is not a number");
+  const std::string bin = cube_binary_ply(false);
+  refused("truncated.ply", bin.substr(0, bin.size() - 5), "the file has 1 left");
+  std::string neg = cube_binary_ply(true);
+  neg = std::string(neg).replace(neg.find("uchar int"), 9, "int int  ");
+  refused("count_type.ply", neg, "binary PLY");  // counts now read as int: body misaligned
+  std::string float_count = ascii;
+  float_count.replace(float_count.find("list uchar"), 10, "list float");
+  refused("float_count.ply", float_count, "integer type");
 }
 
 TEST_F(MeshFiles, BinaryStlSoupIsWeldedAndScaled) {

@@ -8,11 +8,13 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <new>
 #include <set>
 #include <sstream>
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
+#include "pre_import_checks.hpp"
 
 namespace clumpkit {
 
@@ -87,120 +89,6 @@ std::size_t weld_vertices(TriangleMesh& mesh, double tol, std::size_t* collapsed
   return merged;
 }
 
-namespace {
-
-// assimp 5.2 loops forever on a PLY header that never reaches "end_header" (found by fuzzing: a
-// corrupted property line). PLY headers are checked here first: assimp picks its PLY reader by
-// extension or by a leading "ply", so both are checked. Every header line must start with a PLY
-// keyword and the header must end with "end_header".
-void check_ply_header(const fs::path& path, const std::string& where) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  if (!std::getline(in, line)) return;
-  const auto trim = [](std::string& l) {
-    while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
-    const size_t b = l.find_first_not_of(" \t");
-    l = b == std::string::npos ? std::string() : l.substr(b);
-  };
-  trim(line);
-  std::string ext = path.extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (line.rfind("ply", 0) != 0 && ext != ".ply") return;
-  if (line != "ply") throw InputError(where, "", "not a PLY file (the first line must be 'ply')");
-  for (int n = 2; std::getline(in, line); ++n) {
-    trim(line);
-    if (line == "end_header") return;
-    const std::string word = line.substr(0, line.find_first_of(" \t"));
-    if (word != "format" && word != "element" && word != "property" && word != "comment" &&
-        word != "obj_info")
-      throw InputError(where, "line " + std::to_string(n),
-                       "malformed PLY header (expected format, element, property, comment or "
-                       "end_header)");
-    if (word == "element") {
-      // A huge count made assimp allocate tens of GB (found by fuzzing): every element takes at
-      // least one byte of the file.
-      std::istringstream words(line);
-      std::string e, name;
-      long long count = -1;
-      words >> e >> name >> count;
-      std::error_code ec;
-      const auto size = fs::file_size(path, ec);
-      if (count < 0 || ec || static_cast<unsigned long long>(count) > size)
-        throw InputError(where, "line " + std::to_string(n),
-                         "malformed PLY header (element count missing or larger than the file)");
-    }
-    if (word == "property") {
-      // An unknown type made assimp abort() later (found by fuzzing): types are checked here.
-      static const std::set<std::string> types = {
-          "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
-          "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
-      std::istringstream words(line);
-      std::string p, t1, t2, t3;
-      words >> p >> t1 >> t2 >> t3;
-      const bool ok = t1 == "list" ? types.count(t2) && types.count(t3) : types.count(t1) > 0;
-      if (!ok)
-        throw InputError(where, "line " + std::to_string(n),
-                         "malformed PLY header (unknown property type)");
-    }
-  }
-  throw InputError(where, "", "PLY header without end_header");
-}
-
-// assimp 5.2 crashes (SEGV) on OFF files whose face lines are not what the counts promise (found
-// by fuzzing). OFF is simple enough to check completely: the header, the counts, nv vertex lines
-// of 3 numbers and nf face lines "k i1 ... ik" (k >= 3, indices < nv; colours may follow).
-void check_off(const fs::path& path, const std::string& where) {
-  std::string ext = path.extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext != ".off") return;
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  int n = 0;
-  auto next = [&]() {  // the next line that is neither empty nor a comment
-    while (std::getline(in, line)) {
-      ++n;
-      const size_t b = line.find_first_not_of(" \t\r");
-      if (b != std::string::npos && line[b] != '#') return true;
-    }
-    return false;
-  };
-  auto bad = [&](const std::string& what) {
-    throw InputError(where, "line " + std::to_string(n), "malformed OFF file: " + what);
-  };
-  if (!next()) bad("empty");
-  std::istringstream head(line);
-  std::string magic;
-  head >> magic;
-  if (magic.size() < 3 || magic.compare(magic.size() - 3, 3, "OFF") != 0) bad("no OFF header");
-  long long nv = -1, nf = -1, ne = -1;
-  if (!(head >> nv)) {  // counts on their own line
-    if (!next()) bad("missing counts");
-    std::istringstream counts(line);
-    counts >> nv >> nf >> ne;
-  } else {
-    head >> nf >> ne;
-  }
-  if (nv < 0 || nf < 0 || nv > 100'000'000 || nf > 100'000'000) bad("bad vertex/face counts");
-  for (long long v = 0; v < nv; ++v) {
-    if (!next()) bad("fewer vertices than announced");
-    std::istringstream xyz(line);
-    double x, y, z;
-    if (!(xyz >> x >> y >> z)) bad("a vertex needs 3 numbers");
-  }
-  for (long long f = 0; f < nf; ++f) {
-    if (!next()) bad("fewer faces than announced");
-    std::istringstream face(line);
-    long long k = 0;
-    if (!(face >> k) || k < 1 || k > 1'000'000) bad("a face starts with its vertex count");
-    for (long long j = 0; j < k; ++j) {
-      long long i = -1;
-      if (!(face >> i) || i < 0 || i >= nv) bad("face index missing or out of range");
-    }
-  }
-}
-
-}  // namespace
-
 TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshReport* report) {
   const std::string where = path.string();
   if (!(opt.scale > 0) || !std::isfinite(opt.scale))
@@ -209,14 +97,21 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   if (!fs::is_regular_file(path, ec)) throw InputError(where, "", "no such mesh file");
   if (fs::file_size(path, ec) == 0) throw InputError(where, "", "empty file (no triangles)");
 
-  check_ply_header(path, where);
-  check_off(path, where);
+  detail::check_ply(path, where);
+  detail::check_off(path, where);
   Assimp::Importer importer;
   // Only triangles and points/lines are of interest; normals, UVs and materials are not read.
   // No assimp post-processing: its steps (Triangulate, PreTransformVertices, even the structure
   // validation) abort() on corrupt scenes (found by fuzzing). Polygons are fanned here and every
   // index is checked by validate_mesh; the formats read here have no node transforms.
-  const aiScene* scene = importer.ReadFile(path.string(), 0);
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(path.string(), 0);
+  } catch (const std::bad_alloc&) {  // a count the checks above cannot see (other formats)
+    throw InputError(where, "",
+                     "the mesh importer ran out of memory reading it (a count in the file is "
+                     "probably corrupt)");
+  }
   if (!scene) {
     throw InputError(
         where, "",
