@@ -4,7 +4,7 @@
 #   sanitize  ASan + UBSan (+ libFuzzer coverage), tests labelled `sanitize`: every module's fast
 #             tests, the fuzz corpus replays and the bad-input catalogue        -> ${build}-asan/
 #   tsan      ThreadSanitizer (OpenMP via LLVM's Archer), tests labelled `tsan`  -> ${build}-tsan/
-#   fuzz      every libFuzzer target of the sanitize build, CLUMPKIT_FUZZ_SECONDS in total (80)
+#   fuzz      every libFuzzer target of the sanitize build, CLUMPKIT_FUZZ_SECONDS in total (40)
 # Tests labelled `slow` stay out of both sanitizer builds. All stages run by default (CI); for
 # quick local runs CLUMPKIT_CI_QUICK=1 skips the three, CLUMPKIT_CI_SKIP="tsan fuzz" some of them.
 # Called by .ci/bootstrap test. Prints each stage's wall time at the end.
@@ -53,7 +53,7 @@ tsan_stage() {
 }
 
 fuzz_stage() {
-  local dir="${build}-asan" total="${CLUMPKIT_FUZZ_SECONDS:-80}" n
+  local dir="${build}-asan" total="${CLUMPKIT_FUZZ_SECONDS:-40}" n
   configure_clang "$dir" address,undefined ON  # up to date after the sanitize stage
   cmake --build "$dir" -j "$jobs" --target fuzz_targets >/dev/null
   n=$(wc -l < "$dir/tests/fuzz/targets.txt")
