@@ -24,10 +24,11 @@ timed() {
 skipped() { [ "${CLUMPKIT_CI_QUICK:-0}" = 1 ] || [[ " ${CLUMPKIT_CI_SKIP:-} " == *" $1 "* ]]; }
 
 # A clang build at -O1 with asserts on, without benchmarks; only the labelled tests get built.
+# Unity (jumbo) build as in .ci/bootstrap: the ASan build took 328 s one file at a time, 224 s so.
 configure_clang() {  # folder sanitizers fuzz(ON/OFF)
   cmake -S . -B "$1" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
     -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DCLUMPKIT_SANITIZE="$2" -DCLUMPKIT_FUZZ="$3" \
-    -DCLUMPKIT_BUILD_BENCH=OFF >/dev/null
+    -DCLUMPKIT_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 }
 
 sanitize_stage() {

@@ -207,7 +207,7 @@ void print_table(std::vector<Row>& rows) {
                "principal-moment error; axis: principal-axis angle over distinct axes.\n";
 }
 
-Command setup(CLI::App& parent) {
+Command setup_error(CLI::App& parent) {
   auto a = std::make_shared<ErrorArgs>();
   CLI::App* c = parent.add_subcommand(
       "error",
@@ -272,7 +272,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(30, setup);
+const Registration reg_error(30, setup_error);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -22,7 +22,7 @@ std::string formats_help() {
   return h;
 }
 
-Command setup(CLI::App& parent) {
+Command setup_export(CLI::App& parent) {
   auto args = std::make_shared<ExportArgs>();
   CLI::App* c = parent.add_subcommand(
       "export",
@@ -73,7 +73,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(30, setup);
+const Registration reg_export(30, setup_export);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -145,7 +145,7 @@ int run_general(const FillArgs& a) {
   return 0;
 }
 
-Command setup(CLI::App& parent) {
+Command setup_fill(CLI::App& parent) {
   auto args = std::make_shared<FillArgs>();
   CLI::App* c = parent.add_subcommand("fill",
                                       "Fill a shape with a sphere clump and write a "
@@ -224,7 +224,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(10, setup);
+const Registration reg_fill(10, setup_fill);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -14,7 +14,7 @@ struct InfoArgs {
   std::string clump, json;
 };
 
-Command setup(CLI::App& parent) {
+Command setup_info(CLI::App& parent) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* c = parent.add_subcommand("info",
                                       "Summarise a clump template (spheres, mass "
@@ -71,7 +71,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(20, setup);
+const Registration reg_info(20, setup_info);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -20,7 +20,7 @@ struct MeshArgs {
   bool list = false;
 };
 
-Command setup(CLI::App& parent) {
+Command setup_mesh(CLI::App& parent) {
   auto a = std::make_shared<MeshArgs>();
   CLI::App* c = parent.add_subcommand(
       "mesh",
@@ -61,7 +61,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(15, setup);
+const Registration reg_mesh(15, setup_mesh);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -19,7 +19,7 @@ struct PaperArgs {
   std::int64_t rays = RaySamplingOptions{}.rays;
 };
 
-Command setup(CLI::App& parent) {
+Command setup_paper(CLI::App& parent) {
   auto args = std::make_shared<PaperArgs>();
   CLI::App* c = parent.add_subcommand(
       "paper",
@@ -78,7 +78,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(5, setup);
+const Registration reg_paper(5, setup_paper);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -45,7 +45,7 @@ void list_rigs() {
   std::cout << "\n";
 }
 
-Command setup(CLI::App& parent) {
+Command setup_rig(CLI::App& parent) {
   auto a = std::make_shared<RigArgs>();
   CLI::App* c = parent.add_subcommand(
       "rig",
@@ -154,7 +154,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(40, setup);
+const Registration reg_rig(40, setup_rig);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -37,7 +37,7 @@ int report(const sim::RunSummary& s, const std::string& out) {
   return 0;
 }
 
-Command setup(CLI::App& parent) {
+Command setup_sim(CLI::App& parent) {
   auto a = std::make_shared<SimArgs>();
   CLI::App* c = parent.add_subcommand(
       "sim",
@@ -73,7 +73,7 @@ Command setup(CLI::App& parent) {
           }};
 }
 
-const Registration reg(50, setup);
+const Registration reg_sim(50, setup_sim);
 
 }  // namespace
 }  // namespace clumpkit::cli

@@ -17,8 +17,6 @@ struct Unit {
   double factor;
 };
 
-constexpr double kPi = std::numbers::pi;
-
 const std::vector<Unit>& units() {
   static const std::vector<Unit> table = {
       {"", Dimension::Dimensionless, 1.0},
@@ -49,10 +47,10 @@ const std::vector<Unit>& units() {
       {"mm/s", Dimension::Velocity, 1e-3},
       {"mm/min", Dimension::Velocity, 1e-3 / 60.0},
       {"rad", Dimension::Angle, 1.0},
-      {"deg", Dimension::Angle, kPi / 180.0},
+      {"deg", Dimension::Angle, std::numbers::pi / 180.0},
       {"rad/s", Dimension::AngularVelocity, 1.0},
-      {"rpm", Dimension::AngularVelocity, 2.0 * kPi / 60.0},
-      {"deg/s", Dimension::AngularVelocity, kPi / 180.0},
+      {"rpm", Dimension::AngularVelocity, 2.0 * std::numbers::pi / 60.0},
+      {"deg/s", Dimension::AngularVelocity, std::numbers::pi / 180.0},
       {"m^3", Dimension::Volume, 1.0},
       {"L", Dimension::Volume, 1e-3},
       {"mL", Dimension::Volume, 1e-6},

@@ -63,12 +63,6 @@ Eigen::Vector3d random_point(const Region& region, double bound, std::mt19937_64
   return c.base_center + Eigen::Vector3d(rad * std::cos(ang), rad * std::sin(ang), z);
 }
 
-std::string fmt_g(double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
-
 // Spheres near the region, hashed by cell, for overlap tests during a batch.
 struct PlacementGrid {
   double cell;

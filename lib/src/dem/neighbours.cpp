@@ -109,48 +109,69 @@ void World::Impl::rebuild_neighbours() {
   pairs.swap(next);
   pair_hist.swap(next_hist);
 
-  // Wall triangles binned into the cells their (grown) bounding boxes touch; static walls keep
-  // their bins.
-  bool walls_moved = !tri_bins_valid;
-  for (const WallData& wd : walls)
-    if (wd.vertices != wd.vertices_build) walls_moved = true;
-  const double grow = r_max + skin;
-  if (walls_moved) tri_bins.clear();
-  for (size_t wi = 0; wi < walls.size() && walls_moved; ++wi) {
-    const WallData& wd = walls[wi];
-    for (size_t ti = 0; ti < wd.triangles.size(); ++ti) {
-      const auto& t = wd.triangles[ti];
-      Eigen::Vector3d lo =
-          wd.vertices[t[0]].cwiseMin(wd.vertices[t[1]]).cwiseMin(wd.vertices[t[2]]);
-      Eigen::Vector3d hi =
-          wd.vertices[t[0]].cwiseMax(wd.vertices[t[1]]).cwiseMax(wd.vertices[t[2]]);
-      lo.array() -= grow;
-      hi.array() += grow;
-      const std::int64_t x0 = cell_of(lo.x(), h), x1 = cell_of(hi.x(), h);
-      const std::int64_t y0 = cell_of(lo.y(), h), y1 = cell_of(hi.y(), h);
-      const std::int64_t z0 = cell_of(lo.z(), h), z1 = cell_of(hi.z(), h);
-      for (std::int64_t x = x0; x <= x1; ++x)
-        for (std::int64_t y = y0; y <= y1; ++y)
-          for (std::int64_t z = z0; z <= z1; ++z)
-            tri_bins.push_back({cell_key(x, y, z), {int(wi), int(ti)}});
+  // Wall triangles binned into the cells their (grown) bounding boxes touch, in each wall's
+  // frame at t = 0 (once: a wall moves rigidly). The bins only pre-select; the exact test below
+  // is on the current vertices, so the candidates are those of a binning of the moved wall. The
+  // boxes grow by a hair more than the reach, against rounding in the change of frame.
+  const double grow = r_max + skin + 1e-9 * h;
+  const int nw = static_cast<int>(walls.size());
+  if (!tri_bins_valid) {
+    tri_bins.assign(nw, {});
+    for (int wi = 0; wi < nw; ++wi) {
+      const WallData& wd = walls[wi];
+      auto& bins_w = tri_bins[wi];
+      for (size_t ti = 0; ti < wd.triangles.size(); ++ti) {
+        const auto& t = wd.triangles[ti];
+        const auto& v = wd.ref_vertices;
+        Eigen::Vector3d lo = v[t[0]].cwiseMin(v[t[1]]).cwiseMin(v[t[2]]);
+        Eigen::Vector3d hi = v[t[0]].cwiseMax(v[t[1]]).cwiseMax(v[t[2]]);
+        lo.array() -= grow;
+        hi.array() += grow;
+        const std::int64_t x0 = cell_of(lo.x(), h), x1 = cell_of(hi.x(), h);
+        const std::int64_t y0 = cell_of(lo.y(), h), y1 = cell_of(hi.y(), h);
+        const std::int64_t z0 = cell_of(lo.z(), h), z1 = cell_of(hi.z(), h);
+        for (std::int64_t x = x0; x <= x1; ++x)
+          for (std::int64_t y = y0; y <= y1; ++y)
+            for (std::int64_t z = z0; z <= z1; ++z)
+              bins_w.push_back({cell_key(x, y, z), static_cast<int>(ti)});
+      }
+      std::sort(bins_w.begin(), bins_w.end());
     }
+    tri_bins_valid = true;
   }
-  if (walls_moved) std::sort(tri_bins.begin(), tri_bins.end());
-  tri_bins_valid = true;
+  // The map from the world back to each wall's frame at t = 0: X = R^T (x - a) + p0.
+  std::vector<Eigen::Matrix3d> back_rot(nw);
+  std::vector<Eigen::Vector3d> back_from(nw), back_to(nw);
+  std::vector<char> at_rest(nw);
+  for (int wi = 0; wi < nw; ++wi) {
+    const WallPose& pose = walls[wi].state.pose;
+    back_rot[wi] = pose.rotation.transpose();
+    back_from[wi] = pose.axis_point;
+    back_to[wi] = pose.reference_point;
+    at_rest[wi] = pose.rotation.isIdentity(0.0) && pose.axis_point == pose.reference_point;
+  }
   std::vector<std::vector<std::array<int, 2>>> cand(ns);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
-    const std::uint64_t key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
-    auto lo = std::lower_bound(tri_bins.begin(), tri_bins.end(),
-                               std::make_pair(key, std::array<int, 2>{-1, -1}));
     const double reach = s_r[s] + skin;
-    for (auto it = lo; it != tri_bins.end() && it->first == key; ++it) {
-      const auto [wi, ti] = it->second;
+    for (int wi = 0; wi < nw; ++wi) {
+      const auto& bins_w = tri_bins[wi];
+      if (bins_w.empty()) continue;
+      std::uint64_t key;
+      if (at_rest[wi]) {
+        key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
+      } else {
+        const Eigen::Vector3d x = back_rot[wi] * (s_pos[s] - back_from[wi]) + back_to[wi];
+        key = cell_key(cell_of(x.x(), h), cell_of(x.y(), h), cell_of(x.z(), h));
+      }
       const WallData& wd = walls[wi];
-      const auto& t = wd.triangles[ti];
-      const Eigen::Vector3d c = closest_point_on_triangle(s_pos[s], wd.vertices[t[0]],
-                                                          wd.vertices[t[1]], wd.vertices[t[2]]);
-      if ((c - s_pos[s]).squaredNorm() < reach * reach) cand[s].push_back(it->second);
+      auto lo = std::lower_bound(bins_w.begin(), bins_w.end(), std::make_pair(key, -1));
+      for (auto it = lo; it != bins_w.end() && it->first == key; ++it) {
+        const auto& t = wd.triangles[it->second];
+        const Eigen::Vector3d c = closest_point_on_triangle(s_pos[s], wd.vertices[t[0]],
+                                                            wd.vertices[t[1]], wd.vertices[t[2]]);
+        if ((c - s_pos[s]).squaredNorm() < reach * reach) cand[s].push_back({wi, it->second});
+      }
     }
   }
   wall_cand.clear();

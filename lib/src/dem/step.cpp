@@ -22,12 +22,6 @@ double seconds_since(Clock::time_point& t0) {
   return s;
 }
 
-std::string fmt_g(double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
-
 // Body angular momentum π rotated by −θ about principal axis k (the body turns by +θ), given
 // c = cos θ and s = sin θ.
 void rotate_momentum(Eigen::Vector3d& pi, int k, double c, double s) {

@@ -11,13 +11,13 @@
 
 namespace clumpkit::dem {
 
-namespace {
-
 std::string fmt_g(double v) {
   char buf[48];
   std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
+
+namespace {
 
 // Moves a template into its centroid-principal frame (as a safety net: templates from
 // make_clump_template already are) and returns the shared type data.

@@ -15,6 +15,9 @@
 
 namespace clumpkit::dem {
 
+/// A number in messages: four significant digits (printf %.4g).
+std::string fmt_g(double v);
+
 /// Template data shared by every clump of one type (principal frame).
 struct TypeData {
   std::vector<Eigen::Vector3d> offsets;  // sphere centres relative to the centre of mass, m
@@ -136,8 +139,10 @@ struct World::Impl {
   std::vector<ContactHistory> pair_hist;
   std::vector<int> wall_cand_start;
   std::vector<std::array<int, 2>> wall_cand;
-  // Wall triangles binned by cell, reused while no wall has moved since the binning.
-  std::vector<std::pair<std::uint64_t, std::array<int, 2>>> tri_bins;
+  // Per wall, its triangles binned by cell in the wall's own frame (its vertices at t = 0): a
+  // wall moves rigidly, so the bins are built once and a sphere is looked up at its position
+  // carried back into that frame.
+  std::vector<std::vector<std::pair<std::uint64_t, int>>> tri_bins;
   bool tri_bins_valid = false;
   std::vector<std::array<WallSlot, kWallSlots>> wall_slots;
   // Spheres with wall candidates or a wall contact history, ascending: the only spheres the

@@ -29,7 +29,6 @@ namespace clumpkit {
 namespace {
 
 using detail::FillContext;
-constexpr double kPi = std::numbers::pi;
 
 class Optimiser {
  public:
@@ -222,7 +221,7 @@ class Optimiser {
     std::priority_queue<Item> pq;
     for (std::int64_t c = 0; c < static_cast<std::int64_t>(cand_.size()); ++c) {
       const double rho = std::min(ctx_.tolerance - g.sdf[cand_[c]], cap) / g.h;
-      pq.push({4.0 / 3.0 * kPi * rho * rho * rho + 8.0, -1, c});
+      pq.push({4.0 / 3.0 * std::numbers::pi * rho * rho * rho + 8.0, -1, c});
     }
     int added = 0;
     std::vector<Item> batch;
@@ -303,7 +302,8 @@ class Optimiser {
       for (int j = 0; j < n; ++j)
         if (j != i && (s[i].center - s[j].center).norm() < s[i].radius + s[j].radius)
           nb.push_back(j);
-      const double da = 4.0 * kPi * s[i].radius * s[i].radius / static_cast<double>(dirs_.size());
+      const double da =
+          4.0 * std::numbers::pi * s[i].radius * s[i].radius / static_cast<double>(dirs_.size());
       for (const Eigen::Vector3d& u : dirs_) {
         const Eigen::Vector3d p = s[i].center + s[i].radius * u;
         bool hidden = false;
@@ -328,7 +328,7 @@ class Optimiser {
     const int n = static_cast<int>(s.size());
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
     for (int i = 0; i < n; ++i) {
-      const double r = s[i].radius, norm = kPi * r * r;
+      const double r = s[i].radius, norm = std::numbers::pi * r * r;
       const double rho = ctx_.max_radius(s[i].center);
       Eigen::Vector3d dc = g[i].c;
       if (r >= rho - 1e-6 * ctx_.size && g[i].r < 0)  // radius held by the constraint
@@ -477,7 +477,7 @@ class Optimiser {
     // Multi-start: the plain coverage greedy opens with the largest sphere, which can trap the
     // descent (a flat pill); starts whose radii are capped near the equal-volume radius of n
     // spheres spread the spheres out. The best start after a short descent goes on.
-    const double r_eq = std::cbrt(3.0 * ctx_.cache->shape_volume() / (4.0 * kPi * n));
+    const double r_eq = std::cbrt(3.0 * ctx_.cache->shape_volume() / (4.0 * std::numbers::pi * n));
     const double inf = std::numeric_limits<double>::infinity();
     // Starts: the plain, 1.25 r_eq- and r_eq-capped seedings (independent and serial inside, so
     // run side by side), then the r_eq-capped one moved by Lloyd iterations.

@@ -13,9 +13,7 @@ namespace clumpkit {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
-namespace {
-constexpr double kPi = std::numbers::pi;
-}
+namespace {}
 
 // ---------------------------------------------------------------------------------------------
 // Mesh utilities
@@ -112,7 +110,7 @@ TessellatedMesh revolve(const std::vector<Vector2d>& profile, int n, bool closed
       b.pole({0.0, 0.0, q.y()});
     } else {
       b.ring([&](int j) {
-        const double phi = 2.0 * kPi * j / n;
+        const double phi = 2.0 * std::numbers::pi * j / n;
         return Vector3d(q.x() * std::cos(phi), q.x() * std::sin(phi), q.y());
       });
     }
@@ -136,8 +134,9 @@ std::vector<Vector2d> subdivide(const std::vector<Vector2d>& poly, double spacin
 // Ring count and profile spacing for ~`triangles` triangles on a profile of length `length`
 // swept at radius up to `rho_max` (edges about as long around as along).
 void revolve_resolution(int triangles, double length, double rho_max, int& n, double& spacing) {
-  n = std::max(8, static_cast<int>(std::lround(std::sqrt(triangles * kPi * rho_max / length))));
-  spacing = 2.0 * kPi * rho_max / n;
+  n = std::max(
+      8, static_cast<int>(std::lround(std::sqrt(triangles * std::numbers::pi * rho_max / length))));
+  spacing = 2.0 * std::numbers::pi * rho_max / n;
 }
 
 double segment_distance(const Vector2d& p, const Vector2d& a, const Vector2d& b) {
@@ -204,7 +203,7 @@ double ChamferedCylinder::signed_distance(const Vector3d& p) const {
 }
 
 double ChamferedCylinder::volume() const {
-  return kPi * r_ * r_ * h_ - 2.0 * kPi * c_ * c_ * (r_ - c_ / 3.0);
+  return std::numbers::pi * r_ * r_ * h_ - 2.0 * std::numbers::pi * c_ * c_ * (r_ - c_ / 3.0);
 }
 
 TessellatedMesh ChamferedCylinder::tessellate(int triangles) const {
@@ -260,9 +259,9 @@ double Ellipsoid::signed_distance(const Vector3d& p) const {
   const int scan = 64;
   int best = 0;
   for (int i = 1; i <= scan; ++i)
-    if (d2(0.5 * kPi * i / scan) < d2(0.5 * kPi * best / scan)) best = i;
-  double lo = 0.5 * kPi * std::max(0, best - 1) / scan,
-         hi = 0.5 * kPi * std::min(scan, best + 1) / scan;
+    if (d2(0.5 * std::numbers::pi * i / scan) < d2(0.5 * std::numbers::pi * best / scan)) best = i;
+  double lo = 0.5 * std::numbers::pi * std::max(0, best - 1) / scan,
+         hi = 0.5 * std::numbers::pi * std::min(scan, best + 1) / scan;
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   for (int it = 0; it < 60; ++it) {
     const double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
@@ -276,7 +275,7 @@ double Ellipsoid::signed_distance(const Vector3d& p) const {
 }
 
 double Ellipsoid::volume() const {
-  return 4.0 / 3.0 * kPi * a_ * b_ * c_;
+  return 4.0 / 3.0 * std::numbers::pi * a_ * b_ * c_;
 }
 
 TessellatedMesh Ellipsoid::tessellate(int triangles) const {
@@ -285,9 +284,9 @@ TessellatedMesh Ellipsoid::tessellate(int triangles) const {
   RingBuilder b{n, {}, {}};
   b.pole({0, 0, -c_});
   for (int i = 1; i < m; ++i) {
-    const double th = kPi * i / m;
+    const double th = std::numbers::pi * i / m;
     b.ring([&](int j) {
-      const double phi = 2.0 * kPi * j / n;
+      const double phi = 2.0 * std::numbers::pi * j / n;
       return Vector3d(a_ * std::sin(th) * std::cos(phi), b_ * std::sin(th) * std::sin(phi),
                       -c_ * std::cos(th));
     });
@@ -328,18 +327,18 @@ double Capsule::signed_distance(const Vector3d& p) const {
 }
 
 double Capsule::volume() const {
-  return kPi * r_ * r_ * l_ + 4.0 / 3.0 * kPi * r_ * r_ * r_;
+  return std::numbers::pi * r_ * r_ * l_ + 4.0 / 3.0 * std::numbers::pi * r_ * r_ * r_;
 }
 
 TessellatedMesh Capsule::tessellate(int triangles) const {
-  const double len = kPi * r_ + l_;
+  const double len = std::numbers::pi * r_ + l_;
   int n;
   double spacing;
   revolve_resolution(triangles, len, r_, n, spacing);
-  const int arc = std::max(2, static_cast<int>(std::ceil(0.5 * kPi * r_ / spacing)));
+  const int arc = std::max(2, static_cast<int>(std::ceil(0.5 * std::numbers::pi * r_ / spacing)));
   std::vector<Vector2d> prof;
   for (int i = 0; i <= arc; ++i) {
-    const double t = -0.5 * kPi + 0.5 * kPi * i / arc;
+    const double t = -0.5 * std::numbers::pi + 0.5 * std::numbers::pi * i / arc;
     prof.push_back({r_ * std::cos(t), -0.5 * l_ + r_ * std::sin(t)});
   }
   if (l_ > 0) {
@@ -347,7 +346,7 @@ TessellatedMesh Capsule::tessellate(int triangles) const {
     prof.insert(prof.end(), mid.begin() + 1, mid.end());
   }
   for (int i = 1; i <= arc; ++i) {
-    const double t = 0.5 * kPi * i / arc;
+    const double t = 0.5 * std::numbers::pi * i / arc;
     prof.push_back({i == arc ? 0.0 : r_ * std::cos(t), 0.5 * l_ + r_ * std::sin(t)});
   }
   prof.front().x() = 0.0;
@@ -393,7 +392,7 @@ double Torus::signed_distance(const Vector3d& p) const {
 }
 
 double Torus::volume() const {
-  return 2.0 * kPi * kPi * R_ * r_ * r_;
+  return 2.0 * std::numbers::pi * std::numbers::pi * R_ * r_ * r_;
 }
 
 TessellatedMesh Torus::tessellate(int triangles) const {
@@ -402,7 +401,7 @@ TessellatedMesh Torus::tessellate(int triangles) const {
   const int n = std::max(8, triangles / (2 * m));
   std::vector<Vector2d> prof;
   for (int i = 0; i < m; ++i) {
-    const double t = 2.0 * kPi * i / m;
+    const double t = 2.0 * std::numbers::pi * i / m;
     prof.push_back({R_ + r_ * std::cos(t), r_ * std::sin(t)});
   }
   return revolve(prof, n, true);
@@ -463,9 +462,9 @@ TessellatedMesh Superellipsoid::tessellate(int triangles) const {
   RingBuilder b{n, {}, {}};
   b.pole({0, 0, -s_.z()});
   for (int i = 1; i < m; ++i) {
-    const double eta = -0.5 * kPi + kPi * i / m;
+    const double eta = -0.5 * std::numbers::pi + std::numbers::pi * i / m;
     b.ring([&](int j) {
-      const double om = 2.0 * kPi * j / n;
+      const double om = 2.0 * std::numbers::pi * j / n;
       const double ce = spow(std::cos(eta), e1_);
       return Vector3d(s_.x() * ce * spow(std::cos(om), e2_), s_.y() * ce * spow(std::sin(om), e2_),
                       s_.z() * spow(std::sin(eta), e1_));
@@ -721,7 +720,7 @@ std::shared_ptr<const AnalyticSolid> make_test_shape(const std::string& name, st
     const Vector3d stretch(1.0, 0.8, 0.65);
     std::vector<ConvexPolytope::Plane> planes;
     for (int i = 0; i < 24; ++i) {
-      const double z = 2.0 * uniform(s) - 1.0, phi = 2.0 * kPi * uniform(s);
+      const double z = 2.0 * uniform(s) - 1.0, phi = 2.0 * std::numbers::pi * uniform(s);
       const double rxy = std::sqrt(1.0 - z * z);
       const Vector3d n(rxy * std::cos(phi), rxy * std::sin(phi), z);
       const double d = 3.0 * mm * (0.85 + 0.3 * uniform(s));

@@ -10,15 +10,14 @@ namespace clumpkit::rigs {
 
 using Eigen::Vector3d;
 using Tri = std::array<int, 3>;
-constexpr double kPi = std::numbers::pi;
 
 double equal_area_polygon_radius(double r, int n) {
   // n-gon of circumradius R: area n R² sin(2π/n) / 2 = π r².
-  return r * std::sqrt(2.0 * kPi / (n * std::sin(2.0 * kPi / n)));
+  return r * std::sqrt(2.0 * std::numbers::pi / (n * std::sin(2.0 * std::numbers::pi / n)));
 }
 
 double CupGeometry::volume() const {
-  return kPi * 0.25 * inner_diameter * inner_diameter * height;
+  return std::numbers::pi * 0.25 * inner_diameter * inner_diameter * height;
 }
 
 namespace {
@@ -37,7 +36,7 @@ dem::TriangleMesh tube(double r, double z0, double z1, int n, bool inward) {
   dem::TriangleMesh m;
   const double rp = equal_area_polygon_radius(r, n);
   for (int k = 0; k < n; ++k) {
-    const double a0 = 2.0 * kPi * k / n, a1 = 2.0 * kPi * (k + 1) / n;
+    const double a0 = 2.0 * std::numbers::pi * k / n, a1 = 2.0 * std::numbers::pi * (k + 1) / n;
     const Vector3d p0(rp * std::cos(a0), rp * std::sin(a0), z0);
     const Vector3d p1(rp * std::cos(a1), rp * std::sin(a1), z0);
     const Vector3d q0 = p0 + Vector3d(0, 0, z1 - z0), q1 = p1 + Vector3d(0, 0, z1 - z0);
@@ -55,7 +54,7 @@ dem::TriangleMesh disc(double r, double z, int n, bool up) {
   const double rp = equal_area_polygon_radius(r, n);
   m.vertices.push_back(Vector3d(0, 0, z));
   for (int k = 0; k < n; ++k) {
-    const double a = 2.0 * kPi * k / n;
+    const double a = 2.0 * std::numbers::pi * k / n;
     m.vertices.push_back(Vector3d(rp * std::cos(a), rp * std::sin(a), z));
   }
   for (int k = 0; k < n; ++k) {
@@ -94,7 +93,7 @@ dem::TriangleMesh plate_mesh(const LiftingGeometry& g) {
 }
 
 double WheelGeometry::pocket_area() const {
-  const double annulus = kPi * (outer_radius * outer_radius - hub_radius * hub_radius);
+  const double annulus = std::numbers::pi * (outer_radius * outer_radius - hub_radius * hub_radius);
   const double vanes = pockets * vane_thickness * (outer_radius - hub_radius);
   return (annulus - vanes) / pockets;
 }
@@ -111,7 +110,7 @@ dem::TriangleMesh wheel_mesh(const WheelGeometry& g, double phase) {
   const int n = g.arc_segments;
   const double rh = equal_area_polygon_radius(g.hub_radius, n);
   for (int k = 0; k < n; ++k) {
-    const double a0 = 2.0 * kPi * k / n, a1 = 2.0 * kPi * (k + 1) / n;
+    const double a0 = 2.0 * std::numbers::pi * k / n, a1 = 2.0 * std::numbers::pi * (k + 1) / n;
     quad(m, polar(rh, a0, y0, g.axis_height), polar(rh, a0, y1, g.axis_height),
          polar(rh, a1, y1, g.axis_height), polar(rh, a1, y0, g.axis_height));
   }
@@ -119,7 +118,7 @@ dem::TriangleMesh wheel_mesh(const WheelGeometry& g, double phase) {
   // hub and omitted), outward normals.
   const double t = 0.5 * g.vane_thickness;
   for (int k = 0; k < g.pockets; ++k) {
-    const double a = 2.0 * kPi * k / g.pockets + phase;
+    const double a = 2.0 * std::numbers::pi * k / g.pockets + phase;
     const Vector3d u(std::cos(a), 0, std::sin(a)), w(-std::sin(a), 0, std::cos(a));
     const Vector3d c(0, 0, g.axis_height);
     const double r0 = g.hub_radius * 0.9, r1 = g.outer_radius;
@@ -139,16 +138,16 @@ dem::TriangleMesh housing_mesh(const WheelGeometry& g) {
   const double rh = g.outer_radius + g.housing_gap;
   const double y0 = -0.5 * g.length, y1 = 0.5 * g.length;
   const double throat = std::acos(std::clamp(0.5 * g.hopper_opening / rh, 0.0, 1.0));
-  const double outlet = kPi / 6.0;  // the outlet spans ±30° about the bottom
+  const double outlet = std::numbers::pi / 6.0;  // the outlet spans ±30° about the bottom
   dem::TriangleMesh m;
   // Right arc: from the throat edge (angle `throat`) down to −90° + 30°; left arc mirrored.
   for (int side = 0; side < 2; ++side) {
-    const double a_begin = throat, a_end = -0.5 * kPi + outlet;
-    const int n = std::max(4, int(g.arc_segments * (a_begin - a_end) / (2.0 * kPi)));
+    const double a_begin = throat, a_end = -0.5 * std::numbers::pi + outlet;
+    const int n = std::max(4, int(g.arc_segments * (a_begin - a_end) / (2.0 * std::numbers::pi)));
     for (int k = 0; k < n; ++k) {
       double a0 = a_begin + (a_end - a_begin) * k / n,
              a1 = a_begin + (a_end - a_begin) * (k + 1) / n;
-      if (side == 1) a0 = kPi - a0, a1 = kPi - a1;
+      if (side == 1) a0 = std::numbers::pi - a0, a1 = std::numbers::pi - a1;
       const Vector3d p0 = polar(rh, a0, y0, g.axis_height), p1 = polar(rh, a1, y0, g.axis_height);
       const Vector3d q0 = polar(rh, a0, y1, g.axis_height), q1 = polar(rh, a1, y1, g.axis_height);
       if (side == 0)
@@ -163,7 +162,7 @@ dem::TriangleMesh housing_mesh(const WheelGeometry& g) {
 dem::TriangleMesh hopper_mesh(const WheelGeometry& g) {
   const double y0 = -0.5 * g.length, y1 = 0.5 * g.length;
   const double zt = g.throat_z();
-  const double tan_a = std::tan(g.hopper_half_angle_deg * kPi / 180.0);
+  const double tan_a = std::tan(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
   const double h = std::max(0.0, 0.5 * (g.hopper_top_width - g.hopper_opening)) / tan_a;
   const double w0 = 0.5 * g.hopper_opening, w1 = 0.5 * g.hopper_top_width;
   dem::TriangleMesh m;
@@ -182,7 +181,7 @@ dem::TriangleMesh hopper_mesh(const WheelGeometry& g) {
 
 dem::TriangleMesh end_plates_mesh(const WheelGeometry& g) {
   const double zt = g.throat_z();
-  const double tan_a = std::tan(g.hopper_half_angle_deg * kPi / 180.0);
+  const double tan_a = std::tan(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
   const double h = std::max(0.0, 0.5 * (g.hopper_top_width - g.hopper_opening)) / tan_a;
   const double z0 = g.axis_height - g.outer_radius - g.housing_gap;
   const double z1 = zt + h + g.hopper_height;
@@ -210,19 +209,19 @@ std::vector<double> measured_pocket_areas(const WheelGeometry& g, int grid) {
       if (r > R) continue;
       // Inside the hub polygon: compare with the polygon's radius at this angle.
       double a = std::atan2(z, x);
-      if (a < 0) a += 2.0 * kPi;
-      const double seg = 2.0 * kPi / g.arc_segments;
+      if (a < 0) a += 2.0 * std::numbers::pi;
+      const double seg = 2.0 * std::numbers::pi / g.arc_segments;
       const double local = std::fmod(a, seg) - 0.5 * seg;
       if (r * std::cos(local) < rhub * std::cos(0.5 * seg)) continue;
       bool in_vane = false;
       for (int k = 0; k < g.pockets && !in_vane; ++k) {
-        const double b = 2.0 * kPi * k / g.pockets;
+        const double b = 2.0 * std::numbers::pi * k / g.pockets;
         const double along = x * std::cos(b) + z * std::sin(b);
         const double across = -x * std::sin(b) + z * std::cos(b);
         in_vane = along > 0 && std::abs(across) <= 0.5 * g.vane_thickness;
       }
       if (in_vane) continue;
-      const int k = int(a / (2.0 * kPi / g.pockets)) % g.pockets;
+      const int k = int(a / (2.0 * std::numbers::pi / g.pockets)) % g.pockets;
       area[k] += h * h;
     }
   return area;

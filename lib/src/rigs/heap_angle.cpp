@@ -11,8 +11,6 @@ namespace clumpkit::rigs {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 struct Projected {
   double u, z, r;
 };
@@ -99,7 +97,7 @@ WindowResult measure_window(const Spheres& s, const Eigen::Vector2d& axis, doubl
   int nl = 0, nr = 0;
   for (int v = 0; v < o.views; ++v) {
     HeapView hv;
-    hv.azimuth = kPi * v / o.views;
+    hv.azimuth = std::numbers::pi * v / o.views;
     const auto p = project(s, axis, hv.azimuth);
     std::vector<Eigen::Vector2d> el, er;
     for (int k = 0; k < o.rows; ++k) {
@@ -173,7 +171,7 @@ HeapAngle measure_heap_angle(const Spheres& s, const HeapAngleOptions& o) {
   double rb = 0, rt = 0;
   int n = 0;
   for (int v = 0; v < o.views; ++v) {
-    const auto p = project(s, axis, kPi * v / o.views);
+    const auto p = project(s, axis, std::numbers::pi * v / o.views);
     double l0, r0, l1, r1;
     if (!row_edges(p, o.plate_z + 2.0 * rmean, gap, l0, r0)) continue;
     if (!row_edges(p, o.plate_z + 0.95 * height, gap, l1, r1)) continue;
@@ -213,10 +211,10 @@ Spheres synthetic_cone(double base_radius, double angle, double r, unsigned seed
   // Surface rings: centres on the cone, every ~r in height and around.
   for (double z = r; z < height; z += r) {
     const double rho = (height - z) / t;
-    const int n = std::max(1, int(2.0 * kPi * rho / r));
-    const double phase = std::uniform_real_distribution<double>(0, 2 * kPi)(rng);
+    const int n = std::max(1, int(2.0 * std::numbers::pi * rho / r));
+    const double phase = std::uniform_real_distribution<double>(0, 2 * std::numbers::pi)(rng);
     for (int k = 0; k < n; ++k) {
-      const double a = phase + 2.0 * kPi * k / n;
+      const double a = phase + 2.0 * std::numbers::pi * k / n;
       out.push_back({Eigen::Vector3d(rho * std::cos(a), rho * std::sin(a), z), r});
     }
   }

@@ -73,8 +73,6 @@ std::uint8_t channel(std::uint32_t rgb, int shift) {
   return std::uint8_t((rgb >> shift) & 0xff);
 }
 
-constexpr double kPi = std::numbers::pi;
-
 }  // namespace
 
 Canvas::Canvas(int width, int height, std::uint32_t bg)
@@ -187,7 +185,7 @@ void heap_picture(const std::filesystem::path& path, const Spheres& spheres, con
         cv.fill_rect(int(X(e.x())) - 1, int(Y(e.y())) - 1, int(X(e.x())) + 2, int(Y(e.y())) + 2,
                      0x1040d0);
     }
-    const double deg = 180.0 / kPi;
+    const double deg = 180.0 / std::numbers::pi;
     cv.text(ox, 12,
             fmt::format("VIEW 0: L {:.1f} R {:.1f} DEG", v.left.angle * deg, v.right.angle * deg),
             0x000000, 2);

@@ -20,7 +20,6 @@ namespace clumpkit::rigs {
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
 using Clock = std::chrono::steady_clock;
-constexpr double kPi = std::numbers::pi;
 
 // ---------------------------------------------------------------------------------------------
 // Scales.
@@ -568,7 +567,7 @@ RepeatResult angle_of_repose(Ctx& c) {
   g.plate_side = p.plate_side;
   const double R = 0.5 * p.tube_diameter;
   // Can the tube hold the mass? Densest packing of the pills (0.74 of their own density).
-  const double capacity = 0.74 * mean_union_density(c) * kPi * R * R * g.height;
+  const double capacity = 0.74 * mean_union_density(c) * std::numbers::pi * R * R * g.height;
   if (p.heap_mass > capacity)
     throw InputError(
         "--set", "mass",
@@ -654,7 +653,7 @@ RepeatResult angle_of_repose(Ctx& c) {
 
   const Spheres spheres = world_spheres(w);
   const HeapAngle h = measure_heap_angle(spheres);
-  const double deg = 180.0 / kPi;
+  const double deg = 180.0 / std::numbers::pi;
   RepeatResult r;
   r.values["angle"] = h.angle;
   r.values["angle_left"] = h.angle_left;
@@ -729,7 +728,7 @@ RepeatResult discharge(Ctx& c) {
                       {}});
   ws.walls.push_back(wheel(1e9));
   // Hopper capacity: the cone plus its vertical extension, at the pills' densest packing.
-  const double tan_a = std::tan(g.hopper_half_angle_deg * kPi / 180.0);
+  const double tan_a = std::tan(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
   const double hc = 0.5 * (g.hopper_top_width - g.hopper_opening) / tan_a;
   const double hopper_volume = g.length * (0.5 * (g.hopper_opening + g.hopper_top_width) * hc +
                                            g.hopper_top_width * g.hopper_height);
@@ -767,8 +766,8 @@ RepeatResult discharge(Ctx& c) {
   const double t0 = state.at("t_action");
   c.removed_mass = state.value("removed_kg", 0.0);
 
-  const double omega = p.rpm * 2.0 * kPi / 60.0;  // rad/s, about +y: angles decrease
-  const double pitch = 2.0 * kPi / g.pockets;
+  const double omega = p.rpm * 2.0 * std::numbers::pi / 60.0;  // rad/s, about +y: angles decrease
+  const double pitch = 2.0 * std::numbers::pi / g.pockets;
   const double period = pitch / omega;
   const double rh = g.outer_radius + g.housing_gap;
   const double throat = std::acos(0.5 * g.hopper_opening / rh);  // right throat edge angle
@@ -781,15 +780,15 @@ RepeatResult discharge(Ctx& c) {
   std::vector<Pocket> pockets;
   for (int k = 0; k < g.pockets; ++k) {
     double upper = (k + 1) * pitch;
-    while (upper <= throat) upper += 2.0 * kPi;
-    while (upper > throat + 2.0 * kPi) upper -= 2.0 * kPi;
+    while (upper <= throat) upper += 2.0 * std::numbers::pi;
+    while (upper > throat + 2.0 * std::numbers::pi) upper -= 2.0 * std::numbers::pi;
     pockets.push_back({t0 + (upper - throat) / omega, k});
   }
   std::sort(pockets.begin(), pockets.end(), [](auto& a, auto& b) { return a.t_close < b.t_close; });
   const int need = p.pockets_skipped + p.pockets_measured;
   while (int(pockets.size()) < need) {
     Pocket q = pockets[pockets.size() - g.pockets];
-    q.t_close += 2.0 * kPi / omega;
+    q.t_close += 2.0 * std::numbers::pi / omega;
     pockets.push_back(q);
   }
   const double settle_delay = 0.05 * period;
@@ -822,8 +821,8 @@ RepeatResult discharge(Ctx& c) {
         const double r = std::hypot(x.x(), x.z() - g.axis_height);
         if (r < g.hub_radius || r > rh || std::abs(x.y()) > 0.5 * L) continue;
         double a = std::atan2(x.z() - g.axis_height, x.x()) - lower;
-        a = std::fmod(a, 2.0 * kPi);
-        if (a < 0) a += 2.0 * kPi;
+        a = std::fmod(a, 2.0 * std::numbers::pi);
+        if (a < 0) a += 2.0 * std::numbers::pi;
         if (a < pitch) m += w.clump_mass(i);
       }
       if (int(next) >= p.pockets_skipped) fills.push_back(m);
