@@ -142,8 +142,7 @@ Command setup_compare(CLI::App& parent) {
             SpreadPool pool(ms);
             std::set<std::string> pooled_models;
             for (const auto& m : models) {
-              simulated.push_back(
-                  simulate_measurements(sim, m, ms, a->scale, a->repeats, a->seed));
+              simulated.push_back(simulate_measurements(sim, m, ms, a->scale, a->repeats, a->seed));
               if (pooled_models.insert(model_fingerprint(m)).second) pool.add(simulated.back());
             }
             for (size_t i = 0; i < models.size(); ++i) {
@@ -331,7 +330,12 @@ Command setup_synth(CLI::App& parent) {
             RigSimulator sim = make_sim(*a);
             // The truth is simulated with seeds the diagnosis will not use by default.
             const std::uint64_t seed = a->seed + 1000003;
-            const auto s = simulate_measurements(sim, truth, ms, a->scale, a->repeats, seed);
+            // The truth's seed-to-seed spread pooled over each rig quantity's settings (the angle
+            // on three plates): from a few repeats alone it is often several times too small.
+            SpreadPool pool(ms);
+            auto s = simulate_measurements(sim, truth, ms, a->scale, a->repeats, seed);
+            pool.add(s);
+            s = pool.pooled(std::move(s));
             std::mt19937_64 rng(a->seed);
             for (auto& m : ms) {
               const SimulatedValue& t = s.at(m.key());
