@@ -5,7 +5,7 @@ For each hidden effect (and for none), a truth model makes synthetic lab data wi
 `clumpkit synth`; `clumpkit diagnose --apply` runs over the whole catalogue (no --effects) from
 a baseline without the effect; `clumpkit compare` shows the chain baseline -> applied model.
 Measurements: the angle of repose on the three plates and the bulk density in the organic-glass
-cup, pill A with 12 spheres (paper rule), Table 1 materials with the pill's Young's modulus
+cup (--cups: in cups of other wall materials too), pill A with 12 spheres (paper rule), Table 1 materials with the pill's Young's modulus
 lowered to --youngs (default 1e7 Pa; the paper's 1.1e8 Pa with --youngs 1.1e8).
 
 Cases (truth vs baseline; every other effect as in Table 1):
@@ -76,6 +76,9 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--jobs", default="0")
     ap.add_argument("--noise", default="0.03")
+    ap.add_argument("--cups", default="organic_glass",
+                    help="wall materials of the bulk-density cups measured (comma-separated; "
+                         "all three: abs_plastic,organic_glass,galvanized_steel)")
     ap.add_argument("--no-suggest", action="store_true",
                     help="skip the next-measurement suggestion (its trial runs)")
     a = ap.parse_args()
@@ -99,8 +102,9 @@ def main():
                               src, materials, fx))
         with open(os.path.join(d, "template.csv"), "w") as f:
             f.write("rig,sample,setting,quantity,value,std,n,unit\n" + "".join(
-                f"angle_of_repose,A,plate={p},angle,30,1,3,deg\n" for p in WALLS) +
-                "bulk_density,A,wall=organic_glass,bulk_density,700,10,3,kg/m^3\n")
+                f"angle_of_repose,A,plate={p},angle,30,1,3,deg\n" for p in WALLS) + "".join(
+                f"bulk_density,A,wall={c},bulk_density,700,10,3,kg/m^3\n"
+                for c in a.cups.split(",")))
 
         def run(*args):
             with open(os.path.join(d, "log.txt"), "a") as log:
