@@ -5,8 +5,9 @@ For each hidden effect (and for none), a truth model makes synthetic lab data wi
 `clumpkit synth`; `clumpkit diagnose --apply` runs over the whole catalogue (no --effects) from
 a baseline without the effect; `clumpkit compare` shows the chain baseline -> applied model.
 Measurements: the angle of repose on the three plates and the bulk density in the organic-glass
-cup (--cups: in cups of other wall materials too), pill A with 12 spheres (paper rule), Table 1 materials with the pill's Young's modulus
-lowered to --youngs (default 1e7 Pa; the paper's 1.1e8 Pa with --youngs 1.1e8).
+cup (--cups: in cups of other wall materials too), pill A with 12 spheres (paper rule), Table 1
+materials with the pill's Young's modulus lowered to --youngs (default 1e7 Pa; the paper's
+1.1e8 Pa with --youngs 1.1e8).
 
 Cases (truth vs baseline; every other effect as in Table 1):
   rolling_friction   mu_r 0.2 on every pair, baseline 0.05 (with none the small heap spreads flat)
