@@ -142,6 +142,12 @@ TEST(Walls, MotionKinematics) {
   const Eigen::Vector3d fd =
       (wall_pose(m, 1.5 + h).apply(x0) - wall_pose(m, 1.5 - h).apply(x0)) / (2 * h);
   EXPECT_NEAR((fd - b.velocity_at(b.apply(x0))).norm(), 0.0, 1e-6);
+  // unapply carries a world point back to the wall's point at t = 0 (the neighbour search bins
+  // a moving wall's triangles once, in that frame).
+  EXPECT_NEAR((b.unapply(b.apply(x0)) - x0).norm(), 0.0, 1e-15);
+  EXPECT_TRUE(wall_pose(WallMotion{}, 2.0).at_rest());
+  EXPECT_FALSE(b.at_rest());
+  EXPECT_FALSE(a.at_rest());  // translated, not turned
 }
 
 TEST(Walls, LiftingPistonCarriesASphere) {

@@ -139,17 +139,8 @@ void World::Impl::rebuild_neighbours() {
     }
     tri_bins_valid = true;
   }
-  // The map from the world back to each wall's frame at t = 0: X = R^T (x - a) + p0.
-  std::vector<Eigen::Matrix3d> back_rot(nw);
-  std::vector<Eigen::Vector3d> back_from(nw), back_to(nw);
   std::vector<char> at_rest(nw);
-  for (int wi = 0; wi < nw; ++wi) {
-    const WallPose& pose = walls[wi].state.pose;
-    back_rot[wi] = pose.rotation.transpose();
-    back_from[wi] = pose.axis_point;
-    back_to[wi] = pose.reference_point;
-    at_rest[wi] = pose.rotation.isIdentity(0.0) && pose.axis_point == pose.reference_point;
-  }
+  for (int wi = 0; wi < nw; ++wi) at_rest[wi] = walls[wi].state.pose.at_rest();
   std::vector<std::vector<std::array<int, 2>>> cand(ns);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
@@ -161,7 +152,7 @@ void World::Impl::rebuild_neighbours() {
       if (at_rest[wi]) {
         key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
       } else {
-        const Eigen::Vector3d x = back_rot[wi] * (s_pos[s] - back_from[wi]) + back_to[wi];
+        const Eigen::Vector3d x = walls[wi].state.pose.unapply(s_pos[s]);
         key = cell_key(cell_of(x.x(), h), cell_of(x.y(), h), cell_of(x.z(), h));
       }
       const WallData& wd = walls[wi];

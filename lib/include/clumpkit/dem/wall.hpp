@@ -74,6 +74,12 @@ struct WallPose {
   Eigen::Vector3d apply(const Eigen::Vector3d& x0) const {
     return rotation * (x0 - reference_point) + axis_point;
   }
+  /// The inverse of apply: the wall's point at t = 0 that is at world point x now.
+  Eigen::Vector3d unapply(const Eigen::Vector3d& x) const {
+    return rotation.transpose() * (x - axis_point) + reference_point;
+  }
+  /// True when the wall is where it was at t = 0 (apply is the identity).
+  bool at_rest() const { return rotation.isIdentity(0.0) && axis_point == reference_point; }
   /// Velocity of the wall material at world point x.
   Eigen::Vector3d velocity_at(const Eigen::Vector3d& x) const {
     return velocity + omega.cross(x - axis_point);
