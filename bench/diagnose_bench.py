@@ -5,7 +5,8 @@ For each hidden effect (and for none), a truth model makes synthetic lab data wi
 `clumpkit synth`; `clumpkit diagnose --apply` runs over the whole catalogue (no --effects) from
 a baseline without the effect; `clumpkit compare` shows the chain baseline -> applied model.
 Measurements: the angle of repose on the three plates and the bulk density in the organic-glass
-cup (--cups: in cups of other wall materials too), pill A with 12 spheres (paper rule), Table 1
+cup (--cups: in cups of other wall materials too; --discharge: the discharger's mass flow and
+pocket mass at the given wheel speeds), pill A with 12 spheres (paper rule), Table 1
 materials with the pill's Young's modulus lowered to --youngs (default 1e7 Pa; the paper's
 1.1e8 Pa with --youngs 1.1e8).
 
@@ -21,7 +22,7 @@ results are cached in OUT/cache, shared by the cases, so a second run of the scr
 nothing. Prints the wall time per case. Python 3 standard library only.
 
   python3 bench/diagnose_bench.py --clumpkit build/apps/clumpkit/clumpkit --out diag_bench \\
-      [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0] [--no-suggest]
+      [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0] [--no-suggest] [--discharge 15]
 """
 import argparse
 import json
@@ -80,6 +81,9 @@ def main():
     ap.add_argument("--cups", default="organic_glass",
                     help="wall materials of the bulk-density cups measured (comma-separated; "
                          "all three: abs_plastic,organic_glass,galvanized_steel)")
+    ap.add_argument("--discharge", default="",
+                    help="wheel speeds (rpm, comma-separated) at which the discharger's mass flow "
+                         "and pocket mass are measured too (e.g. 15); none by default")
     ap.add_argument("--no-suggest", action="store_true",
                     help="skip the next-measurement suggestion (its trial runs)")
     a = ap.parse_args()
@@ -105,7 +109,10 @@ def main():
             f.write("rig,sample,setting,quantity,value,std,n,unit\n" + "".join(
                 f"angle_of_repose,A,plate={p},angle,30,1,3,deg\n" for p in WALLS) + "".join(
                 f"bulk_density,A,wall={c},bulk_density,700,10,3,kg/m^3\n"
-                for c in a.cups.split(",")))
+                for c in a.cups.split(",")) + "".join(
+                f"discharge,A,rpm={r},{q},{v},{e},3,{u}\n" for r in filter(None,
+                a.discharge.split(",")) for q, v, e, u in (
+                    ("mass_flow", 0.3, 0.01, "kg/s"), ("pocket_mass", 0.15, 0.005, "kg"))))
 
         def run(*args):
             with open(os.path.join(d, "log.txt"), "a") as log:
