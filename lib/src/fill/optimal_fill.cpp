@@ -412,13 +412,12 @@ class Optimiser {
         ctx_.cache->local(s, i, cur.radius + 2.0 * delta[i] + 1e-9 * ctx_.size, L, max_lines,
                           sweep * 7 + i);
         ++evaluations_;
-        const double base = ctx_.cache->local_value(L, cur);
         Eigen::Vector3d dc = g[i].c;
         if (cur.radius >= rho_cur - 1e-6 * ctx_.size && g[i].r < 0)
           dc -= g[i].r * ctx_.distance_gradient(cur.center);
         // Trials are cheap here: the descent direction at three step lengths, the six axis
         // directions, and the radius alone. They are scored in parallel and compared in order.
-        trials.clear();
+        trials.assign(1, cur);  // trials[0]: the current sphere, the base value
         auto shift = [&](const Eigen::Vector3d& u, double len) {
           Sphere t;
           t.center = cur.center + len * u;
@@ -443,11 +442,17 @@ class Optimiser {
         }
         const int nt = static_cast<int>(trials.size());
         values.resize(nt);
-#pragma omp parallel for num_threads(threads_) schedule(static)
-        for (int k = 0; k < nt; ++k) values[k] = ctx_.cache->local_value(L, trials[k]);
+        // Scored in contiguous runs, one per thread (each run reads the neighbourhood once).
+        const int runs = std::min(threads_, nt);
+#pragma omp parallel for num_threads(runs) schedule(static, 1)
+        for (int p = 0; p < runs; ++p) {
+          const int k0 = nt * p / runs, k1 = nt * (p + 1) / runs;
+          ctx_.cache->local_values(L, trials.data() + k0, k1 - k0, values.data() + k0);
+        }
+        const double base = values[0];
         double best_d = -1e-9 * vs;
         Sphere best = cur;
-        for (int k = 0; k < nt; ++k)
+        for (int k = 1; k < nt; ++k)
           if (values[k] - base < best_d) {
             best_d = values[k] - base;
             best = trials[k];

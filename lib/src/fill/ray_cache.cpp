@@ -18,19 +18,52 @@ std::uint64_t splitmix(std::uint64_t x) {
 double to_unit(std::uint64_t x) {
   return static_cast<double>(x >> 11) * 0x1.0p-53;
 }
-// A line's events are few (a handful of chords): insertion sort beats std::sort there. Stable,
-// so equal positions keep their insertion order.
-template <class T, class Less>
-void sort_small(std::vector<T>& v, Less less) {
-  if (v.size() > 32) {
-    std::stable_sort(v.begin(), v.end(), less);
-    return;
-  }
+// Sweep events along a line: position and a key that orders ties (see evaluate). Sorting on
+// (t, key) is a total order, so std::sort gives the same sequence whatever the input order.
+struct Event {
+  double t;
+  int key;
+  bool operator<(const Event& o) const { return t < o.t || (t == o.t && key < o.key); }
+};
+// Insertion sort: linear on the nearly sorted chord ends the callers produce (chords generated
+// in order of the spheres' centres along the line).
+void sort_nearly_sorted(std::vector<double>& v) {
   for (size_t k = 1; k < v.size(); ++k) {
-    T x = v[k];
+    const double x = v[k];
     size_t m = k;
-    for (; m > 0 && less(x, v[m - 1]); --m) v[m] = v[m - 1];
+    for (; m > 0 && x < v[m - 1]; --m) v[m] = v[m - 1];
     v[m] = x;
+  }
+}
+// Sphere indices in order of their centres along each axis (ties by index).
+void axis_orders(const Spheres& spheres, std::vector<int> (&order)[3]) {
+  for (int axis = 0; axis < 3; ++axis) {
+    order[axis].resize(spheres.size());
+    for (size_t k = 0; k < spheres.size(); ++k) order[axis][k] = static_cast<int>(k);
+    std::sort(order[axis].begin(), order[axis].end(), [&](int a, int b) {
+      const double ca = spheres[a].center[axis], cb = spheres[b].center[axis];
+      return ca < cb || (ca == cb && a < b);
+    });
+  }
+}
+// Walks the events of one line in increasing position: the sorted shape boundaries (toggles),
+// chord starts and chord ends; ties are taken in that order (shape, start, end), so the cover
+// count never drops below its value on either side of the tie. Calls f(t, kind) with kind 0, 1,
+// 2; stops after the last end if `to_last_end` (beyond it nothing is covered).
+template <class F>
+void merge_events(const double* bnd, size_t nb, const std::vector<double>& st,
+                  const std::vector<double>& en, bool to_last_end, F&& f) {
+  size_t ib = 0, is = 0, ie = 0;
+  const size_t ns = st.size(), ne = en.size();
+  while (ie < ne || (!to_last_end && (ib < nb || is < ns))) {
+    const bool hb = ib < nb, hs = is < ns, he = ie < ne;
+    if (hb && (!hs || bnd[ib] <= st[is]) && (!he || bnd[ib] <= en[ie])) {
+      f(bnd[ib++], 0);
+    } else if (hs && (!he || st[is] <= en[ie])) {
+      f(st[is++], 1);
+    } else {
+      f(en[ie++], 2);
+    }
   }
 }
 }  // namespace
@@ -95,11 +128,6 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
     double t0, t1;
     int id;
   };
-  // Sweep events along one line: position, kind (0 shape toggle, 1 sphere start, 2 sphere end).
-  struct Event {
-    double t;
-    int kind, id;
-  };
   // Work is split into fixed blocks of lines (kBlocks per axis, independent of the thread count),
   // each computed into its own slot and summed in a fixed order: the result is bit-identical
   // whatever the number of threads, and two threads share three axes evenly.
@@ -110,12 +138,18 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
     std::vector<double> cost;
   };
   std::vector<BlockOut> outs(3 * kBlocks);
+  // Chords are generated in order of the spheres' centres along the line, so their starts and
+  // their ends are each nearly sorted already.
+  std::vector<int> order[3];
+  axis_orders(spheres, order);
+  const bool detailed = moments || removal_cost;
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
   for (int task = 0; task < 3 * kBlocks; ++task) {
     const int axis = task / kBlocks, block = task % kBlocks;
     std::vector<int> count, start;
     std::vector<Chord> items;
     std::vector<Event> ev;
+    std::vector<double> st, en, bnd;
     IntervalList uni;
     std::vector<double>& cost = outs[task].cost;
     if (removal_cost) cost.assign(spheres.size(), 0.0);
@@ -128,7 +162,7 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
     // Two passes of a counting sort: sphere chords bucketed by line (local index l - lbase).
     count.assign(lines + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
-      for (int id = 0; id < static_cast<int>(spheres.size()); ++id) {
+      for (const int id : order[axis]) {
         const Sphere& s = spheres[id];
         const int i0 =
             std::max(ib, static_cast<int>(std::floor((s.center[u] - s.radius - A.u0) / A.du)));
@@ -165,20 +199,62 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
     for (int ll = 0; ll < lines; ++ll) {
       if (count[ll + 1] == count[ll]) continue;
       const int l = ll + lbase;
+      const Chord* chords = items.data() + count[ll];
+      const int nc = count[ll + 1] - count[ll];
+      double lu = 0.0, li = 0.0;
+      if (!detailed) {
+        // Union and intersection lengths only: the chord starts and ends sorted separately and
+        // merged with the shape's boundaries. The same segments are summed in the same order as
+        // in the full sweep below, so the sums are the same to the bit.
+        st.resize(nc);
+        en.resize(nc);
+        for (int k = 0; k < nc; ++k) {
+          st[k] = chords[k].t0;
+          en[k] = chords[k].t1;
+        }
+        sort_nearly_sorted(st);
+        sort_nearly_sorted(en);
+        bnd.clear();
+        for (int k = A.first[l]; k < A.first[l + 1]; ++k) {
+          bnd.push_back(A.shape[k].t0);
+          bnd.push_back(A.shape[k].t1);
+        }
+        int cover = 0;
+        bool in_shape = false, started = false;
+        double prev = 0.0;
+        merge_events(bnd.data(), bnd.size(), st, en, true, [&](double t, int kind) {
+          if (started && cover > 0) {
+            const double len = t - prev;
+            lu += len;
+            if (in_shape) li += len;
+          }
+          started = true;
+          prev = t;
+          if (kind == 0)
+            in_shape = !in_shape;
+          else
+            cover += kind == 1 ? 1 : -1;
+        });
+        xor_len += lu - 2.0 * li;
+        uni_len += lu;
+        continue;
+      }
+      // The full sweep (moments, removal costs). Event keys: 0 a shape boundary, 2 id + 1 and
+      // 2 id + 2 the start and end of sphere id's chord, so ties are taken in sphere order.
       ev.clear();
       for (int k = A.first[l]; k < A.first[l + 1]; ++k) {
-        ev.push_back({A.shape[k].t0, 0, -1});
-        ev.push_back({A.shape[k].t1, 0, -1});
+        ev.push_back({A.shape[k].t0, 0});
+        ev.push_back({A.shape[k].t1, 0});
       }
-      for (int k = count[ll]; k < count[ll + 1]; ++k) {
-        ev.push_back({items[k].t0, 1, items[k].id});
-        ev.push_back({items[k].t1, 2, items[k].id});
+      for (int k = 0; k < nc; ++k) {
+        ev.push_back({chords[k].t0, 2 * chords[k].id + 1});
+        ev.push_back({chords[k].t1, 2 * chords[k].id + 2});
       }
-      sort_small(ev, [](const Event& a, const Event& b) { return a.t < b.t; });
+      std::sort(ev.begin(), ev.end());
       int cover = 0;
       long long idsum = 0;
       bool in_shape = false;
-      double lu = 0.0, li = 0.0, open = 0.0;
+      double open = 0.0;
       uni.clear();
       for (size_t k = 0; k < ev.size(); ++k) {
         if (k > 0) {
@@ -190,14 +266,14 @@ RayCache::Eval RayCache::evaluate(const Spheres& spheres, bool moments,
           }
         }
         const Event& x = ev[k];
-        if (x.kind == 0) {
+        if (x.key == 0) {
           in_shape = !in_shape;
-        } else if (x.kind == 1) {
+        } else if (x.key & 1) {
           if (cover++ == 0) open = x.t;
-          idsum += x.id;
+          idsum += (x.key - 1) / 2;
         } else {
           if (--cover == 0 && moments) uni.push_back({open, x.t});
-          idsum -= x.id;
+          idsum -= (x.key - 1) / 2;
         }
       }
       // |S xor U| = |S| + |U| - 2 |S and U|; |S| is added per axis below.
@@ -255,11 +331,14 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
     int axis, a, b0, b1;
   };
   std::vector<Row> rows;
-  std::vector<int> near[3];
+  // The other spheres near the neighbourhood, per axis in order of their centres along it (so
+  // the chord starts and ends on a line come nearly sorted).
+  std::vector<int> near[3], order[3];
+  axis_orders(spheres, order);
   for (int axis = 0; axis < 3; ++axis) {
     const Axis& A = axes_[axis];
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    for (int id = 0; id < static_cast<int>(spheres.size()); ++id) {
+    for (const int id : order[axis]) {
       const Sphere& s = spheres[id];
       if (id != i && std::abs(s.center[u] - c[u]) < s.radius + reach &&
           std::abs(s.center[v] - c[v]) < s.radius + reach &&
@@ -284,7 +363,7 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
     P.t.clear();
     P.w.clear();
     P.slope.clear();
-    std::vector<std::pair<double, int>> ev;
+    std::vector<double> bnd, st, en;  // shape boundaries, chord starts, chord ends in the window
     const int r0 = static_cast<int>(static_cast<std::int64_t>(nrows) * p / parts);
     const int r1 = static_cast<int>(static_cast<std::int64_t>(nrows) * (p + 1) / parts);
     std::vector<int> row_near;
@@ -307,7 +386,9 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
         const int l = rows[r].a * A.nv + b;
         const double du = A.pu[l] - c[u], dv = A.pv[l] - c[v];
         if (du * du + dv * dv >= reach * reach) continue;
-        ev.clear();
+        bnd.clear();
+        st.clear();
+        en.clear();
         bool in_shape = false;
         for (int k = A.first[l]; k < A.first[l + 1]; ++k) {
           const double t0 = A.shape[k].t0, t1 = A.shape[k].t1;
@@ -315,8 +396,8 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
           if (t0 <= lo)
             in_shape = true;
           else
-            ev.push_back({t0, 0});
-          if (t1 < hi) ev.push_back({t1, 0});
+            bnd.push_back(t0);
+          if (t1 < hi) bnd.push_back(t1);
         }
         int cover = 0;
         for (int id : row_near) {
@@ -330,10 +411,11 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
           if (t0 <= lo)
             ++cover;
           else
-            ev.push_back({t0, 1});
-          if (t1 < hi) ev.push_back({t1, 2});
+            st.push_back(t0);
+          if (t1 < hi) en.push_back(t1);
         }
-        sort_small(ev, [](const auto& x, const auto& y) { return x.first < y.first; });
+        sort_nearly_sorted(st);
+        sort_nearly_sorted(en);
         const int first = static_cast<int>(P.t.size());
         double w = 0.0, prev = lo;
         double sl = cover > 0 ? 0.0 : (in_shape ? -1.0 : 1.0);
@@ -341,21 +423,21 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
         P.t.push_back(lo);
         P.w.push_back(0.0);
         P.slope.push_back(sl);
-        for (const auto& e : ev) {
-          w += sl * (e.first - prev);
-          prev = e.first;
-          if (e.second == 0)
+        merge_events(bnd.data(), bnd.size(), st, en, false, [&](double t, int kind) {
+          w += sl * (t - prev);
+          prev = t;
+          if (kind == 0)
             in_shape = !in_shape;
-          else if (e.second == 1)
+          else if (kind == 1)
             ++cover;
           else
             --cover;
           sl = cover > 0 ? 0.0 : (in_shape ? -1.0 : 1.0);
           zero = zero && sl == 0.0;
-          P.t.push_back(e.first);
+          P.t.push_back(t);
           P.w.push_back(w);
           P.slope.push_back(sl);
-        }
+        });
         if (zero) {
           P.t.resize(first);
           P.w.resize(first);
@@ -369,30 +451,49 @@ void RayCache::local(const Spheres& spheres, int i, double reach, Local& L, int 
 }
 
 double RayCache::local_value(const Local& L, const Sphere& s) const {
-  double total[3] = {0.0, 0.0, 0.0};
-  const double r2 = s.radius * s.radius;
-  for (const Local::Part& P : L.parts) {
-    // W(t) on a line: cumulative weight from the window's start (t below it only by round-off).
-    auto W = [&P](const Local::Line& ln, double t) {
-      const double* first = P.t.data() + ln.b0;
-      const double* last = P.t.data() + ln.b1;
-      const double* it = std::upper_bound(first, last, t);
-      if (it == first) return P.w[ln.b0] + P.slope[ln.b0] * (t - *first);
-      const int k = static_cast<int>(it - P.t.data()) - 1;
-      return P.w[k] + P.slope[k] * (t - P.t[k]);
-    };
-    for (const Local::Line& ln : P.lines) {
-      const int u = (ln.axis + 1) % 3, v = (ln.axis + 2) % 3;
-      const double x = ln.pu - s.center[u], y = ln.pv - s.center[v];
-      const double h2 = r2 - x * x - y * y;
-      if (h2 <= 0) continue;
-      const double hh = std::sqrt(h2);
-      total[ln.axis] += W(ln, s.center[ln.axis] + hh) - W(ln, s.center[ln.axis] - hh);
+  double out = 0.0;
+  local_values(L, &s, 1, &out);
+  return out;
+}
+
+void RayCache::local_values(const Local& L, const Sphere* s, int n, double* out) const {
+  // Lines outer, spheres inner: the neighbourhood is read once per chunk of spheres, and each
+  // sphere's sum still runs over the lines in the same order as for a single sphere.
+  constexpr int kChunk = 32;
+  for (int k0 = 0; k0 < n; k0 += kChunk) {
+    const int m = std::min(kChunk, n - k0);
+    double total[kChunk][3] = {};
+    double r2[kChunk];
+    for (int k = 0; k < m; ++k) r2[k] = s[k0 + k].radius * s[k0 + k].radius;
+    for (const Local::Part& P : L.parts) {
+      // W(t) on a line: cumulative weight from the window's start (t below it only by round-off).
+      auto W = [&P](const Local::Line& ln, double t) {
+        const double* first = P.t.data() + ln.b0;
+        const double* last = P.t.data() + ln.b1;
+        const double* it = std::upper_bound(first, last, t);
+        if (it == first) return P.w[ln.b0] + P.slope[ln.b0] * (t - *first);
+        const int k = static_cast<int>(it - P.t.data()) - 1;
+        return P.w[k] + P.slope[k] * (t - P.t[k]);
+      };
+      for (const Local::Line& ln : P.lines) {
+        const int u = (ln.axis + 1) % 3, v = (ln.axis + 2) % 3;
+        for (int k = 0; k < m; ++k) {
+          const Sphere& sk = s[k0 + k];
+          const double x = ln.pu - sk.center[u], y = ln.pv - sk.center[v];
+          const double h2 = r2[k] - x * x - y * y;
+          if (h2 <= 0) continue;
+          const double hh = std::sqrt(h2);
+          total[k][ln.axis] += W(ln, sk.center[ln.axis] + hh) - W(ln, sk.center[ln.axis] - hh);
+        }
+      }
+    }
+    for (int k = 0; k < m; ++k) {
+      double o = 0.0;
+      for (int axis = 0; axis < 3; ++axis)
+        o += total[k][axis] * axes_[axis].du * axes_[axis].dv / 3.0;
+      out[k0 + k] = o * L.scale;
     }
   }
-  double out = 0.0;
-  for (int axis = 0; axis < 3; ++axis) out += total[axis] * axes_[axis].du * axes_[axis].dv / 3.0;
-  return out * L.scale;
 }
 
 }  // namespace clumpkit::detail

@@ -57,6 +57,9 @@ class RayCache {
   /// the neighbourhood's reach. Differences of two calls are exact changes of the XOR volume
   /// on the cache's rays (without subsampling).
   double local_value(const Local& L, const Sphere& s) const;
+  /// local_value of `n` spheres at once (`out[k]` for `s[k]`, the same values to the bit): the
+  /// neighbourhood is read once for many trials.
+  void local_values(const Local& L, const Sphere* s, int n, double* out) const;
 
   double shape_volume() const { return shape_volume_; }
   const Moments& shape_moments() const { return shape_moments_; }
