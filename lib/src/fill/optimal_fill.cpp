@@ -155,7 +155,8 @@ class Optimiser {
     }
   }
 
-  void mark(std::vector<std::uint8_t>& covered, const Sphere& s) const {
+  // Clears `open` (1: inside voxel not yet covered) in the ball.
+  void mark(std::vector<std::uint8_t>& open, const Sphere& s) const {
     const auto& g = ctx_.grid;
     const Eigen::Vector3d q = (s.center - g.origin) / g.h;
     const int reach = static_cast<int>(std::ceil(s.radius / g.h)) + 1;
@@ -172,35 +173,40 @@ class Optimiser {
         const int x0 = static_cast<int>(std::floor(q.x())) - half;
         const int x1 = static_cast<int>(std::ceil(q.x())) + half;
         for (int i = std::max(0, x0); i <= std::min(g.n.x() - 1, x1); ++i)
-          if ((g.center(i, j, k) - s.center).squaredNorm() <= r2) covered[g.index(i, j, k)] = 1;
+          if ((g.center(i, j, k) - s.center).squaredNorm() <= r2) open[g.index(i, j, k)] = 0;
       }
   }
 
-  // Uncovered inside volume (in voxels) within the ball; sub-sampled for large balls.
-  double gain(const std::vector<std::uint8_t>& covered, std::int64_t v, double r) const {
+  // Uncovered inside volume (in voxels) within the ball; sub-sampled for large balls (every s-th
+  // voxel of each axis, offsets from the centre voxel that are multiples of s).
+  double gain(const std::vector<std::uint8_t>& open, std::int64_t v, double r) const {
     const auto& g = ctx_.grid;
     const int ci = static_cast<int>(v % g.n.x()), cj = static_cast<int>((v / g.n.x()) % g.n.y()),
               ck = static_cast<int>(v / (static_cast<std::int64_t>(g.n.x()) * g.n.y()));
     const int s = std::max(1, static_cast<int>(r / (5.0 * g.h)));
     const int reach = static_cast<int>(r / g.h) / s * s;
     const double r2 = (r / g.h) * (r / g.h);
-    double count = 0.0;
+    std::int64_t count = 0;
     for (int dk = -reach; dk <= reach; dk += s) {
       const int k = ck + dk;
       if (k < 0 || k >= g.n.z()) continue;
       for (int dj = -reach; dj <= reach; dj += s) {
         const int j = cj + dj;
         if (j < 0 || j >= g.n.y()) continue;
-        for (int di = -reach; di <= reach; di += s) {
-          const int i = ci + di;
-          if (i < 0 || i >= g.n.x()) continue;
-          if (di * di + dj * dj + dk * dk > r2) continue;
-          const std::int64_t idx = g.index(i, j, k);
-          if (g.inside[idx] && !covered[idx]) count += 1.0;
-        }
+        // The offsets di with di^2 + dj^2 + dk^2 <= r2 (the square root's guess made exact).
+        const int q = dj * dj + dk * dk;
+        if (q > r2) continue;
+        int dm = static_cast<int>(std::sqrt(r2 - q));
+        while ((dm + 1) * (dm + 1) + q <= r2) ++dm;
+        while (dm * dm + q > r2) --dm;
+        int lo = std::max({-dm, -reach, -ci});
+        const int hi = std::min({dm, reach, g.n.x() - 1 - ci});
+        lo = lo >= 0 ? (lo + s - 1) / s * s : -(-lo / s * s);  // up to a multiple of s
+        const std::uint8_t* row = open.data() + g.index(ci, j, k);
+        for (int di = lo; di <= hi; di += s) count += row[di];
       }
     }
-    return count * s * s * s;
+    return static_cast<double>(count) * s * s * s;
   }
 
   // Adds up to `count` spheres by lazy-greedy maximum coverage, radii capped at `cap`. Returns
@@ -208,8 +214,8 @@ class Optimiser {
   int seed(Spheres& spheres, int count,
            double cap = std::numeric_limits<double>::infinity()) const {
     const auto& g = ctx_.grid;
-    std::vector<std::uint8_t> covered(g.size(), 0);
-    for (const Sphere& s : spheres) mark(covered, s);
+    std::vector<std::uint8_t> open = g.inside;  // inside voxels not yet covered
+    for (const Sphere& s : spheres) mark(open, s);
     struct Item {
       double bound;
       int round;
@@ -261,7 +267,7 @@ class Optimiser {
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
           for (int k = 0; k < nb; ++k) {
             const double rho = std::min(ctx_.tolerance - g.sdf[cand_[batch[k].cand]], cap);
-            batch[k].bound = gain(covered, cand_[batch[k].cand], rho);
+            batch[k].bound = gain(open, cand_[batch[k].cand], rho);
             batch[k].round = round;
           }
           for (const Item& it : batch) pq.push(it);
@@ -280,7 +286,7 @@ class Optimiser {
         if (s.radius < std::max(o_.min_radius, 1e-6 * ctx_.size)) continue;  // drop candidate
         spheres.push_back(s);
         placed.push_back(s);
-        mark(covered, s);
+        mark(open, s);
         ++added;
         break;
       }
