@@ -5,10 +5,11 @@ For each hidden effect (and for none), a truth model makes synthetic lab data wi
 `clumpkit synth`; `clumpkit diagnose --apply` runs over the whole catalogue (no --effects) from
 a baseline without the effect; `clumpkit compare` shows the chain baseline -> applied model.
 Measurements: the angle of repose on the three plates and the bulk density in the organic-glass
-cup (--cups: in cups of other wall materials too; --discharge: the discharger's mass flow and
-pocket mass at the given wheel speeds), pill A with 12 spheres (paper rule), Table 1
+cup (--cups: in cups of other wall materials too; --discharge: the discharger's mass flow at
+the given wheel speeds), pill A with 12 spheres (paper rule), Table 1
 materials with the pill's Young's modulus lowered to --youngs (default 1e7 Pa; the paper's
-1.1e8 Pa with --youngs 1.1e8).
+1.1e8 Pa with --youngs 1.1e8). --plates, --cups and --discharge choose the measurements,
+--effects narrows the diagnosis (default: the whole catalogue).
 
 Cases (truth vs baseline; every other effect as in Table 1):
   rolling_friction   mu_r 0.2 on every pair, baseline 0.05 (with none the small heap spreads flat)
@@ -23,6 +24,7 @@ nothing. Prints the wall time per case. Python 3 standard library only.
 
   python3 bench/diagnose_bench.py --clumpkit build/apps/clumpkit/clumpkit --out diag_bench \\
       [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0] [--no-suggest] [--discharge 15]
+      [--plates abs_plastic] [--cups ""] [--effects wall_friction,particle_friction]
 """
 import argparse
 import json
@@ -81,9 +83,16 @@ def main():
     ap.add_argument("--cups", default="organic_glass",
                     help="wall materials of the bulk-density cups measured (comma-separated; "
                          "all three: abs_plastic,organic_glass,galvanized_steel)")
+    ap.add_argument("--plates", default=",".join(WALLS),
+                    help="plate materials of the angle-of-repose measurements (comma-separated; "
+                         "empty for none)")
+    ap.add_argument("--effects", default="",
+                    help="narrow the diagnosis to these effects (comma-separated; default: the "
+                         "whole catalogue)")
     ap.add_argument("--discharge", default="",
                     help="wheel speeds (rpm, comma-separated) at which the discharger's mass flow "
-                         "and pocket mass are measured too (e.g. 15); none by default")
+                         "is measured too (e.g. 15); none by default. Not the pocket mass: "
+                         "it is the mass flow times the pocket period, the same measurement")
     ap.add_argument("--no-suggest", action="store_true",
                     help="skip the next-measurement suggestion (its trial runs)")
     a = ap.parse_args()
@@ -107,12 +116,12 @@ def main():
                               src, materials, fx))
         with open(os.path.join(d, "template.csv"), "w") as f:
             f.write("rig,sample,setting,quantity,value,std,n,unit\n" + "".join(
-                f"angle_of_repose,A,plate={p},angle,30,1,3,deg\n" for p in WALLS) + "".join(
+                f"angle_of_repose,A,plate={p},angle,30,1,3,deg\n"
+                for p in filter(None, a.plates.split(","))) + "".join(
                 f"bulk_density,A,wall={c},bulk_density,700,10,3,kg/m^3\n"
-                for c in a.cups.split(",")) + "".join(
-                f"discharge,A,rpm={r},{q},{v},{e},3,{u}\n" for r in filter(None,
-                a.discharge.split(",")) for q, v, e, u in (
-                    ("mass_flow", 0.3, 0.01, "kg/s"), ("pocket_mass", 0.15, 0.005, "kg"))))
+                for c in filter(None, a.cups.split(","))) + "".join(
+                f"discharge,A,rpm={r},mass_flow,0.3,0.01,3,kg/s\n"
+                for r in filter(None, a.discharge.split(","))))
 
         def run(*args):
             with open(os.path.join(d, "log.txt"), "a") as log:
@@ -126,6 +135,7 @@ def main():
         t1 = time.time()
         run("diagnose", "--model", "base.toml", "--measurements", "lab.csv", "--apply", "-o",
             "v2.toml", "--json", "diag.json", "--report", "report", *common,
+            *(["--effects", a.effects] if a.effects else []),
             *(["--no-suggest"] if a.no_suggest else []))
         t2 = time.time()
         with open(os.path.join(d, "diag.json")) as f:
@@ -157,7 +167,7 @@ def main():
             json.dump(rows, f, indent=1)
     with open(os.path.join(out, "results.md"), "w") as f:
         f.write(f"scale {a.scale}, pill Young's modulus {a.youngs} Pa, noise {a.noise}, "
-                "diagnose over the whole catalogue, 2 repeats, synth 4 repeats\n\n"
+                f"diagnose over {a.effects or 'the whole catalogue'}, 2 repeats, synth 4 repeats\n\n"
                 "| hidden effect | verdict (confidence) | top candidate: fitted ± std | truth | "
                 "χ²/dof baseline → applied | rig runs | diagnose wall time |\n"
                 "|---|---|---|---|---|---|---|\n")

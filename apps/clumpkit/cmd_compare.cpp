@@ -109,6 +109,13 @@ void check_outputs(const CalArgs& a) {
   }
 }
 
+// Observables that are one measurement (a discharge's mass flow and pocket mass, say) would be
+// counted twice in chi-squared: said on stderr, not refused (a lab may have measured both).
+void warn_redundant(const std::vector<Measurement>& ms, const std::string& file) {
+  for (const std::string& w : redundancy_warnings(ms, file))
+    std::cerr << "clumpkit: warning: " << w << "\n";
+}
+
 Command setup_compare(CLI::App& parent) {
   auto a = std::make_shared<CalArgs>();
   CLI::App* c = parent.add_subcommand(
@@ -127,6 +134,7 @@ Command setup_compare(CLI::App& parent) {
   common_options(c, *a);
   return {c, [a] {
             const auto ms = load_measurements(a->measurements);  // validated before any run
+            warn_redundant(ms, a->measurements);
             std::vector<ParticleModel> models;
             for (const auto& m : a->models) models.push_back(load_model(find_model(m), data_dir()));
             if (!a->report.empty()) {
@@ -194,6 +202,7 @@ Command setup_diagnose(CLI::App& parent) {
   common_options(c, *a);
   return {c, [a] {
             const auto ms = load_measurements(a->measurements);
+            warn_redundant(ms, a->measurements);
             if (ms.size() < 3)
               throw InputError(a->measurements, "",
                                fmt::format("{} observable(s) are too few to tell effects apart "
@@ -325,6 +334,7 @@ Command setup_synth(CLI::App& parent) {
   common_options(c, *a);
   return {c, [a] {
             auto ms = load_measurements(a->measurements);
+            warn_redundant(ms, a->measurements);
             const ParticleModel truth = load_model(find_model(a->models.front()), data_dir());
             check_writable(a->output, "--output");
             RigSimulator sim = make_sim(*a);

@@ -103,3 +103,29 @@ TEST(Measurements, FormatRoundTrips) {
     EXPECT_DOUBLE_EQ(r[i].std, m[i].std);
   }
 }
+
+TEST(Measurements, OneMeasurementGivenTwiceIsNamedByItsLines) {
+  // mass_flow is pocket_mass x 8 x rpm / 60 in every run, angle the mean of the two flanks: a
+  // file with both counts one measurement twice; the pairs are named, independent rows are not.
+  const auto m = parse_measurements(kHeader +
+                                        "discharge,A,rpm=15,pocket_mass,0.17,0.01,3,kg\n"
+                                        "discharge,A,rpm=30,mass_flow,0.6,0.02,3,kg/s\n"
+                                        "discharge,A,rpm=15,mass_flow,0.34,0.02,3,kg/s\n"
+                                        "discharge,A,rpm=15,pocket_mass_cv,0.05,0.01,3,1\n"
+                                        "angle_of_repose,A,,angle_left,30,1,3,deg\n"
+                                        "angle_of_repose,A,,angle,30,1,3,deg\n"
+                                        "angle_of_repose,B,,angle,30,1,3,deg\n"
+                                        "bulk_density,A,,bulk_density,700,10,3,kg/m^3\n",
+                                    "lab.csv");
+  const std::vector<std::string> w = redundancy_warnings(m, "lab.csv");
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_NE(w[0].find("lab.csv:2 (pocket_mass) and line 4 (mass_flow), discharge rpm=15"),
+            std::string::npos)
+      << w[0];
+  EXPECT_NE(w[1].find("lab.csv:6 (angle_left) and line 7 (angle), angle_of_repose:"),
+            std::string::npos)
+      << w[1];
+  EXPECT_NE(w[0].find("counts this measurement twice"), std::string::npos);
+  EXPECT_TRUE(
+      redundancy_warnings(std::vector<Measurement>(m.begin() + 1, m.begin() + 2), "x").empty());
+}

@@ -1,5 +1,6 @@
 #include "clumpkit/calibrate/measurements.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -163,6 +164,24 @@ std::vector<Measurement> parse_measurements(const std::string& text, const std::
 
 std::vector<Measurement> load_measurements(const std::filesystem::path& path) {
   return parse_measurements(read_file(path), path.string());
+}
+
+std::vector<std::string> redundancy_warnings(const std::vector<Measurement>& ms,
+                                             const std::string& name) {
+  std::vector<std::string> out;
+  for (size_t i = 0; i < ms.size(); ++i)
+    for (size_t j = i + 1; j < ms.size(); ++j) {
+      const Measurement &a = ms[i], &b = ms[j];
+      if (a.rig != b.rig || a.sample != b.sample || a.setting != b.setting) continue;
+      const std::vector<std::string> same = same_measurement_as(a.rig, a.quantity);
+      if (std::find(same.begin(), same.end(), b.quantity) == same.end()) continue;
+      out.push_back(name + ":" + std::to_string(a.line) + " (" + a.quantity + ") and line " +
+                    std::to_string(b.line) + " (" + b.quantity + "), " + a.rig +
+                    (a.setting.empty() ? std::string() : " " + a.setting_text()) +
+                    ": one is computed from the other in every rig run, so " +
+                    "chi-squared counts this measurement twice; give one of them");
+    }
+  return out;
 }
 
 std::string format_measurements(const std::vector<Measurement>& ms) {

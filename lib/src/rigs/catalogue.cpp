@@ -81,6 +81,18 @@ const RigInfo& find_rig(const std::string& name, const std::string& where,
   throw InputError(where, field, "unknown rig '" + name + "' (known: " + known + ")");
 }
 
+std::vector<std::string> same_measurement_as(const std::string& rig, const std::string& quantity) {
+  if (rig == "discharge") {
+    if (quantity == "mass_flow") return {"pocket_mass"};
+    if (quantity == "pocket_mass") return {"mass_flow"};
+  }
+  if (rig == "angle_of_repose") {
+    if (quantity == "angle") return {"angle_left", "angle_right"};
+    if (quantity == "angle_left" || quantity == "angle_right") return {"angle"};
+  }
+  return {};
+}
+
 const std::vector<std::string>& known_samples() {
   static const std::vector<std::string> s = {"A", "B", "C", "mix"};
   return s;

@@ -31,6 +31,12 @@ struct Measurement {
 std::vector<Measurement> load_measurements(const std::filesystem::path& path);
 std::vector<Measurement> parse_measurements(const std::string& text, const std::string& name);
 
+/// One warning per pair of observables of the same rig, sample and setting that are one
+/// measurement (same_measurement_as: e.g. a discharge's mass flow and pocket mass), naming both
+/// lines of `name`: chi-squared would count that measurement twice. Empty when there are none.
+std::vector<std::string> redundancy_warnings(const std::vector<Measurement>& m,
+                                             const std::string& name);
+
 /// Writes measurements back as CSV (canonical units), e.g. for `clumpkit synth`.
 std::string format_measurements(const std::vector<Measurement>& m);
 

@@ -41,6 +41,12 @@ const std::vector<RigInfo>& rig_catalogue();
 const RigInfo& find_rig(const std::string& name, const std::string& where = "",
                         const std::string& field = "rig");
 
+/// The other quantities of the same rig run that `quantity` is computed from or that are
+/// computed from it, so that measuring both counts one measurement twice in a chi-squared sum:
+/// discharge's mass_flow is pocket_mass x pockets x rpm / 60; angle_of_repose's angle is the mean
+/// of angle_left and angle_right. Empty for an independent quantity.
+std::vector<std::string> same_measurement_as(const std::string& rig, const std::string& quantity);
+
 /// Samples a measurement may refer to: a pill type or the production mixture.
 const std::vector<std::string>& known_samples();
 
