@@ -62,6 +62,11 @@ std::string read_file(const fs::path& path) {
   return ss.str();
 }
 
+bool path_exists(const fs::path& path) noexcept {
+  std::error_code ec;
+  return fs::exists(path, ec) && !ec;
+}
+
 void check_writable(const fs::path& path, const std::string& field) {
   fs::path dir = path.parent_path();
   if (dir.empty()) dir = ".";

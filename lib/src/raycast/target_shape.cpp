@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/core/units.hpp"
 #include "clumpkit/mesh_io/load_mesh.hpp"
@@ -61,12 +62,12 @@ TargetShape target_from_source(const ClumpTemplate& clump, const std::string& wh
     scale = unit_factor(u, Dimension::Length, where, "source.units");
   // Relative paths are taken relative to the template's folder.
   auto resolve = [&](const fs::path& p) {
-    if (p.is_absolute() || fs::exists(p)) return p;
+    if (p.is_absolute() || path_exists(p)) return p;
     return fs::path(where).parent_path() / p;
   };
   const std::string file = str("file"), mesh = str("mesh"), kind = str("kind");
   TargetShape t;
-  if (!file.empty() && !is_mesh_file(file) && fs::exists(resolve(file))) {
+  if (!file.empty() && !is_mesh_file(file) && path_exists(resolve(file))) {
     t = target_from_shape(load_shape(resolve(file)));
   } else if (!mesh.empty() || (!file.empty() && is_mesh_file(file))) {
     const fs::path p = resolve(mesh.empty() ? file : mesh);

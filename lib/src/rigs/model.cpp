@@ -62,9 +62,9 @@ namespace {
 fs::path resolve(const fs::path& p, const fs::path& base, const fs::path& data_dir) {
   if (p.is_absolute()) return p;
   const fs::path local = base / p;
-  if (fs::exists(local) || data_dir.empty()) return local;
+  if (path_exists(local) || data_dir.empty()) return local;
   const fs::path bundled = data_dir / p;
-  return fs::exists(bundled) ? bundled : local;
+  return path_exists(bundled) ? bundled : local;
 }
 
 // Per-partner values "pill = 0.08", "abs_plastic = 0.12" of an effect table; `defaults` fills
@@ -124,7 +124,7 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
     try {
       m.materials = MaterialLibrary::load(m.materials_path);
     } catch (const InputError& e) {
-      if (!fs::exists(m.materials_path))
+      if (!path_exists(m.materials_path))
         doc.fail("model.materials", "file '" + *mp + "' not found");
       throw;
     }
@@ -160,7 +160,7 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
       doc.fail(p + "name", "type names must be non-empty and unique");
     const std::string shape = doc.string(p + "shape");
     t.shape_path = resolve(shape, base, data_dir);
-    if (!fs::exists(t.shape_path)) doc.fail(p + "shape", "file '" + shape + "' not found");
+    if (!path_exists(t.shape_path)) doc.fail(p + "shape", "file '" + shape + "' not found");
     t.shape = load_shape(t.shape_path);
     const bool has_rule = doc.has(p + "paper_spheres"), has_clump = doc.has(p + "clump");
     if (has_rule == has_clump)
@@ -173,7 +173,7 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
     } else {
       const std::string c = doc.string(p + "clump");
       t.clump_path = resolve(c, base, data_dir);
-      if (!fs::exists(t.clump_path)) doc.fail(p + "clump", "file '" + c + "' not found");
+      if (!path_exists(t.clump_path)) doc.fail(p + "clump", "file '" + c + "' not found");
     }
     t.mass_fraction = doc.number_opt(p + "mass_fraction").value_or(t.shape.mass_fraction);
     doc.require_range(p + "mass_fraction", t.mass_fraction, 0.0, 1.0, true, false);
@@ -295,7 +295,7 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
 }
 
 ParticleModel load_model(const fs::path& path, const fs::path& data_dir) {
-  if (!fs::exists(path)) throw InputError(path.string(), "", "model file not found");
+  if (!path_exists(path)) throw InputError(path.string(), "", "model file not found");
   return parse_model(read_file(path), path, data_dir);
 }
 

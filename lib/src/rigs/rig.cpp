@@ -325,7 +325,7 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
   int quiet = 0;
   // Resumed from a checkpoint taken inside this settle (same phase, same time): continue its
   // bookkeeping, so that it ends where an uninterrupted run's does.
-  if (!c.dir.empty() && fs::exists(c.dir / "state.json")) {
+  if (!c.dir.empty() && path_exists(c.dir / "state.json")) {
     try {
       const auto saved = nlohmann::json::parse(read_file(c.dir / "state.json"));
       if (saved.value("phase", 0) == phase && saved.contains("settle") &&
@@ -403,7 +403,7 @@ dem::VelocityProfile step_velocity(double t_on, double t_off, const Vector3d& v)
 }
 
 nlohmann::json load_state(const Ctx& c) {
-  if (c.dir.empty() || !fs::exists(c.dir / "state.json")) return {{"phase", 0}};
+  if (c.dir.empty() || !path_exists(c.dir / "state.json")) return {{"phase", 0}};
   try {
     return nlohmann::json::parse(read_file(c.dir / "state.json"));
   } catch (const nlohmann::json::exception&) {
@@ -423,7 +423,7 @@ dem::World open_world(Ctx& c, const dem::WorldSettings& ws, const nlohmann::json
     const fs::path ck =
         c.dir / (state.contains("checkpoint") ? state.at("checkpoint").get<std::string>()
                                               : fmt::format("phase{}.ckpt", phase));
-    if (!fs::exists(ck))
+    if (!path_exists(ck))
       throw InputError((c.dir / "state.json").string(), "checkpoint",
                        "names " + ck.filename().string() +
                            ", which is missing: delete the repeat's folder to start it again");
@@ -917,7 +917,7 @@ RigResult run_rig(const RigRequest& req) {
       c.dir = req.out / fmt::format("repeat_{}", k + 1);
       fs::create_directories(c.dir);
       const fs::path done = c.dir / "result.json";
-      if (fs::exists(done)) {
+      if (path_exists(done)) {
         const auto j = nlohmann::json::parse(read_file(done));
         RepeatResult r;
         r.seed = j.at("seed");

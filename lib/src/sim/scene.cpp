@@ -1,5 +1,6 @@
 #include "clumpkit/sim/scene.hpp"
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/fill/paper_fill.hpp"
 #include "clumpkit/geometry/shape_spec.hpp"
@@ -51,8 +52,8 @@ dem::ClumpTypeSettings parse_clump(const TomlDoc& doc, const std::string& key, c
   } else {
     std::string shape = doc.string(key + ".shape");
     fs::path sp = resolve(path, shape);
-    if (!fs::exists(sp)) sp = data_dir / "shapes" / (shape + ".toml");
-    if (!fs::exists(sp)) doc.fail(key + ".shape", "no shape file '" + shape + "'");
+    if (!path_exists(sp)) sp = data_dir / "shapes" / (shape + ".toml");
+    if (!path_exists(sp)) doc.fail(key + ".shape", "no shape file '" + shape + "'");
     PaperFillRequest req;
     req.spheres = static_cast<int>(doc.integer(key + ".spheres"));
     try {

@@ -14,6 +14,11 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
 /// Reads a whole file; throws InputError naming the path if it cannot be read.
 std::string read_file(const std::filesystem::path& path);
 
+/// Whether `path` names something that exists. Never throws: a path the system cannot even look
+/// up (a name too long, a component that is not a folder, no permission) counts as not there, so
+/// a reader reports it as a missing file with the field that named it, not as a system error.
+bool path_exists(const std::filesystem::path& path) noexcept;
+
 /// Checks up front that `path` could be created (its folder exists and is writable), so commands
 /// fail before doing expensive work. Throws InputError naming the path and `field`.
 void check_writable(const std::filesystem::path& path, const std::string& field = "");
