@@ -84,6 +84,21 @@ struct Surrogate {
     if (theta > hi) return at(hi) + slope(hi) * (theta - hi);
     return at(theta);
   }
+  // Variance of a simulated mean through the surrogate: the points' own seed scatter (std^2/n,
+  // pooled over the points that have it), else `fallback`. Heaps with more rolling friction
+  // scatter more than the baseline's (tiny scale: 2-4 deg against 1.6), so the baseline's
+  // scatter alone understated the fitted uncertainty.
+  double noise_var(const std::string& key, double fallback) const {
+    double sum = 0.0;
+    int k = 0;
+    for (const auto& [t, v] : points) {
+      const auto it = v.find(key);
+      if (it == v.end() || it->second.n < 2) continue;
+      sum += it->second.std * it->second.std / it->second.n;
+      ++k;
+    }
+    return k > 0 ? std::max(fallback, sum / k) : fallback;
+  }
 
  private:
   struct Poly {
@@ -141,7 +156,8 @@ double chi2_of(const std::vector<Measurement>& ms, const Values& base, const Sur
   double chi2 = 0;
   for (const auto& m : ms) {
     const SimulatedValue& b = base.at(m.key());
-    const double var = m.std * m.std / m.n + (b.n > 0 ? b.std * b.std / b.n : 0.0);
+    const double var =
+        m.std * m.std / m.n + s.noise_var(m.key(), b.n > 0 ? b.std * b.std / b.n : 0.0);
     const double d = s.value(m.key(), theta) - m.value;
     chi2 += d * d / var;
   }

@@ -110,6 +110,7 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   out.torque_j.setZero();
   out.roll_i = out.roll_j = 0.0;
   out.elastic_energy = 0.0;
+  out.dashpot_n = out.dashpot_t = 0.0;
   if (!(delta > 0.0)) {
     // Closing contact: the overlap ended during the step; only the damping impulse that
     // belongs to the part of the window before the separation is left.
@@ -131,6 +132,7 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
     // c δ^(1/4) δ̇ = dΦ/dt, Φ(δ) = (4/5) c δ^(5/4); δ̇ = −vdn.
     const double c =
         kDampingFactor * law.beta * std::sqrt(2.0 * law.e_star * std::sqrt(k.r_star) * k.m_star);
+    out.dashpot_n = c * std::sqrt(std::sqrt(delta));
     if (dt > 0.0) {
       const double d_up = delta - 0.5 * dt * vdn;
       const double phi_up = d_up > 0.0 ? 0.8 * c * d_up * std::sqrt(std::sqrt(d_up)) : 0.0;
@@ -169,7 +171,8 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
       ft *= cap / fs;
       h.shear = -ft / st;
     } else if (law.damping) {
-      ft -= kDampingFactor * law.beta * std::sqrt(st * k.m_star) * (vd - vdn * n);
+      out.dashpot_t = kDampingFactor * law.beta * std::sqrt(st * k.m_star);
+      ft -= out.dashpot_t * (vd - vdn * n);
     }
     out.force += ft;
     out.elastic_energy += 0.5 * st * h.shear.squaredNorm();

@@ -3,6 +3,8 @@
 // (Dullweber, Leimkuhler & McLachlan 1997), which keeps the gyroscopic term exact per sub-step.
 #include <omp.h>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -48,6 +50,50 @@ inline void half_angle_sincos(double x, double& s, double& c) {
   }
   s = std::sin(x);
   c = std::cos(x);
+}
+
+// Implicit damping (docs/dem.md): bounds on the rates at which one contact's dashpots act on
+// one clump, 1/s, normal and tangential apart (the engine integrates them differently). The
+// dashpots (linear coefficients c_n, c_t on the relative velocity) act at the contact point,
+// whose mobility (inverse effective mass) along the normal is at most 1/m + |r × n|² / I_min and
+// along any direction at most 1/m + |r|² / I_min, r from the clump's centre of mass. Summed over
+// a clump's contacts (pair contacts twice: (x + y)ᵀ C (x + y) ≤ 2 (xᵀ C x + yᵀ C y)), times the
+// step, they bound the fastest damped modes the clump takes part in.
+inline Eigen::Vector2d dashpot_load(const ContactForce& f, const TypeData& t,
+                                    const Eigen::Vector3d& r, const Eigen::Vector3d& n) {
+  const double inv_i = t.inv_inertia.maxCoeff();
+  return {f.dashpot_n * (t.inv_mass + r.cross(n).squaredNorm() * inv_i),
+          f.dashpot_t * (t.inv_mass + r.squaredNorm() * inv_i)};
+}
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// Adds a contact's dashpots to a clump's damping matrix C in world coordinates (v, ω), lower
+// triangle: c_t on every direction of the contact point's velocity v + ω × r, and c_n − c_t
+// more along the normal. For the isotropic part, Σ_e j_e j_eᵀ over the axes e with
+// j_e = (e, r × e) is [[I, −[r]ₓ], [[r]ₓ, |r|² I − r rᵀ]] in closed form.
+inline void add_dashpots(Matrix6d& c, const Eigen::Vector3d& r, const Eigen::Vector3d& n,
+                         double cn, double ct) {
+  if (ct > 0.0) {
+    const double r2 = r.squaredNorm();
+    for (int i = 0; i < 3; ++i) {
+      c(i, i) += ct;
+      for (int k = 0; k <= i; ++k)
+        c(3 + i, 3 + k) += ct * ((i == k ? r2 : 0.0) - r[i] * r[k]);
+    }
+    // Lower-left block (rows ω, columns v): [r]ₓ.
+    c(3, 1) -= ct * r.z(), c(3, 2) += ct * r.y();
+    c(4, 0) += ct * r.z(), c(4, 2) -= ct * r.x();
+    c(5, 0) -= ct * r.y(), c(5, 1) += ct * r.x();
+  }
+  const double k = cn - ct;
+  if (k != 0.0) {
+    Vector6d j;
+    j.head<3>() = n;
+    j.tail<3>() = r.cross(n);
+    c.selfadjointView<Eigen::Lower>().rankUpdate(j, k);
+  }
 }
 
 }  // namespace
@@ -454,11 +500,17 @@ void World::Impl::compute_forces(double hdt) {
     wd.state.torque.setZero();
   }
   elastic = 0.0;
+  const bool implicit = settings.implicit_damping > 0.0;
+  if (implicit) {
+    c_damp.resize(nc);
+    if (scratch_slot.size() < static_cast<size_t>(std::max(threads, 1))) scratch_slot.resize(std::max(threads, 1));
+  }
+  long n_implicit = 0;
   // One parallel region: clump kinematics, the pair and wall laws, then the sums. Each thread
   // sums the forces of its own block of clumps, visiting the contacts in list order (pairs by
   // (i, j), then spheres by index), so every clump's sum is the same sequence of additions for
   // any thread count; thread 0 also adds up the walls' loads and the energies.
-#pragma omp parallel num_threads(threads) if (npc + static_cast <int>(s_r.size()) >= kParallelMin)
+#pragma omp parallel num_threads(threads) if (npc + static_cast <int>(s_r.size()) >= kParallelMin) reduction(+ : n_implicit)
   {
 #pragma omp for schedule(static)
     for (int c = 0; c < nc; ++c) {
@@ -539,6 +591,7 @@ void World::Impl::compute_forces(double hdt) {
       c_f[c].setZero();
       c_t[c].setZero();
       c_mroll[c] = 0.0;
+      if (implicit) c_damp[c].setZero();
     }
     auto mine = [&](int c) { return c >= c0 && c < c1; };
     for (const PairContactData& pc : pair_contacts) {
@@ -547,13 +600,18 @@ void World::Impl::compute_forces(double hdt) {
       const bool own_i = mine(ci), own_j = mine(cj);
       if (!own_i && !own_j) continue;
       const bool rolling = law(types[c_type[ci]].material, types[c_type[cj]].material).rolling;
+      const bool damped = implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0);
       if (own_i) {
         c_f[ci] += pc.out.force;
         c_t[ci] += pc.moment_i;
+        if (damped)
+          c_damp[ci] += 2.0 * dashpot_load(pc.out, types[c_type[ci]], pc.point - c_x[ci], pc.normal);
       }
       if (own_j) {
         c_f[cj] -= pc.out.force;
         c_t[cj] -= pc.moment_j;
+        if (damped)
+          c_damp[cj] += 2.0 * dashpot_load(pc.out, types[c_type[cj]], pc.point - c_x[cj], pc.normal);
       }
       if (rolling) {
         if (own_i) c_t[ci] += pc.out.torque_i, c_mroll[ci] += pc.out.roll_i;
@@ -569,6 +627,67 @@ void World::Impl::compute_forces(double hdt) {
         c_t[c] += wc.moment;
         if (law(types[c_type[c]].material, walls[wc.wall].material).rolling)
           c_t[c] += wc.out.torque_i, c_mroll[c] += wc.out.roll_i;
+        if (implicit)
+          c_damp[c] += dashpot_load(wc.out, types[c_type[c]], wc.point - c_x[c], wc.normal);
+      }
+    }
+    if (implicit && hdt > 0.0) {
+      // Implicit damping for the clumps whose dashpot load is above the gate: their own velocity
+      // enters their damping implicitly (backward Euler), the neighbours' explicitly. The step
+      // then applies F_eff = M (M + dt C)^-1 F, with C the clump's damping matrix and F its
+      // whole force and torque (gravity included, so a clump at rest stays at rest). Explicit
+      // damping overshoots above a rate of about 1/step; this cannot (docs/dem.md).
+      std::vector<std::pair<int, Matrix6d>> hot;
+      std::vector<int>& slot = scratch_slot[t];
+      for (int c = c0; c < c1; ++c)
+        if (c_damp[c].x() * dt > settings.implicit_damping ||
+            c_damp[c].y() * dt > kTangentialGate * settings.implicit_damping) {
+          if (slot.size() < static_cast<size_t>(nc)) slot.resize(nc, -1);
+          slot[c] = static_cast<int>(hot.size());
+          hot.push_back({c, Matrix6d::Zero()});
+        }
+      if (!hot.empty()) {
+        for (const PairContactData& pc : pair_contacts) {
+          if (pc.out.dashpot_n == 0.0 && pc.out.dashpot_t == 0.0) continue;
+          const PairEntry& p = pairs[pc.pair];
+          for (const int c : {s_clump[p.i], s_clump[p.j]})
+            if (mine(c) && slot[c] >= 0)
+              add_dashpots(hot[slot[c]].second, pc.point - c_x[c], pc.normal, pc.out.dashpot_n,
+                           pc.out.dashpot_t);
+        }
+        for (int s : wall_active) {
+          const int c = s_clump[s];
+          if (!mine(c) || slot[c] < 0) continue;
+          for (int k = 0; k < wall_contact_n[s]; ++k) {
+            const WallContactData& wc = wall_contacts[s][k];
+            add_dashpots(hot[slot[c]].second, wc.point - c_x[c], wc.normal, wc.out.dashpot_n,
+                         wc.out.dashpot_t);
+          }
+        }
+        for (auto& [c, cm] : hot) {
+          // (M + dt C) y = F in world coordinates, M = diag(m, m, m, R I Rᵀ); F_eff = M y.
+          const TypeData& ty = types[c_type[c]];
+          const Eigen::Matrix3d inertia =
+              c_R[c] * ty.inertia.asDiagonal() * c_R[c].transpose();
+          // The normal impulse is telescoped over two steps and the damping velocity is
+          // extrapolated: in a pure dashpot the scheme's fastest (alternating) mode responds to
+          // up to twice the coefficient, and the filter with C alone lets it grow once Γ dt is a
+          // few units. C is weighted 1 + σ/(1 + σ) (σ = the clump's load × dt ≥ Γ dt): about 1
+          // for gentle contacts, 2 for stiff jams (a scalar model of both schemes is stable for
+          // every Γ dt with this weight, docs/dem.md).
+          const double sigma = c_damp[c].maxCoeff() * dt;
+          Matrix6d a = (dt * (1.0 + sigma / (1.0 + sigma))) * cm;
+          a.diagonal().head<3>().array() += ty.mass;
+          a.bottomRightCorner<3, 3>() += inertia;
+          Vector6d f;
+          f.head<3>() = c_f[c] + ty.mass * settings.gravity;
+          f.tail<3>() = c_t[c];
+          const Vector6d y = a.llt().solve(f);
+          c_f[c] = ty.mass * y.head<3>() - ty.mass * settings.gravity;
+          c_t[c] = inertia * y.tail<3>();
+          slot[c] = -1;
+          ++n_implicit;
+        }
       }
     }
     if (t == 0) {
@@ -584,6 +703,10 @@ void World::Impl::compute_forces(double hdt) {
           wall_work += f.dot(wc.wall_velocity) * hdt;
         }
     }
+  }
+  if (hdt > 0.0) {
+    profile.clump_steps += nc;
+    profile.implicit_clump_steps += n_implicit;
   }
 }
 

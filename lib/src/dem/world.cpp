@@ -255,6 +255,9 @@ World World::create(WorldSettings s) {
     throw InputError(where, "pinch_release",
                      "must be in [0, 0.5) (a fraction of a sphere radius; 0 = off)");
   if (!s.gravity.allFinite()) throw InputError(where, "gravity", "must be finite");
+  if (!(s.implicit_damping >= 0.0 && s.implicit_damping <= 2.0))
+    throw InputError(where, "implicit_damping",
+                     "must be in [0, 2] (dashpot load x time step; 0 = off, 0.5 advised)");
   if (smallest_type >= 0) {
     const Material& m = w.materials[w.types[smallest_type].material];
     const double tr = rayleigh_time(w.r_min, m.density, m.shear_modulus(), m.poisson_ratio);
@@ -272,8 +275,38 @@ World World::create(WorldSettings s) {
     // rate Γ = c/m_eq (normal and tangential dashpots) must stay below 1/step: explicit damping
     // grows without bound above 2, and a jammed pill was seen to blow up at Γ dt = 1.98.
     constexpr double kStepsPerImpact = 10.0, kDampingLimit = 1.0;
-    double tc_min = std::numeric_limits<double>::infinity(), gamma_max = 0.0;
-    std::string tc_what, gamma_what;
+    double tc_min = std::numeric_limits<double>::infinity(), gamma_max = 0.0, gamma_one = 0.0;
+    std::string tc_what, gamma_what, one_what;
+    // With implicit damping: the largest load its gate assigns to a single contact (step.cpp,
+    // dashpot_load), at the impact's largest overlap. The default step keeps it below the gate,
+    // so an isolated contact is integrated as before and keeps the restitution it was given.
+    const bool implicit = s.implicit_damping > 0.0;
+    // Per contact and clump: the normal and tangential loads of step.cpp's gate at the worst
+    // lever arm (the clump's bounding radius), as a rate against the gates.
+    auto consider_one = [&](const ResolvedContact& law, double r_star, double m_star,
+                            const TypeData& ta, const TypeData* tb, const std::string& what) {
+      if (!law.damping) return;
+      const double d = hertz_max_overlap(law.e_star, r_star, m_star, s.max_impact_speed);
+      const double k = contact_damping_factor() * law.beta;
+      const double cn = k * std::sqrt(2.0 * law.e_star * std::sqrt(r_star * d) * m_star);
+      const double ct =
+          law.friction ? k * std::sqrt(8.0 * law.g_star * std::sqrt(r_star * d) * m_star) : 0.0;
+      // Any direction: the lever arm reaches the bounding radius; along the normal only the
+      // sphere centre's offset turns the clump (r × n = offset × n).
+      auto mob = [](const TypeData& t, bool normal) {
+        double arm = t.bound_radius;
+        if (normal) {
+          arm = 0.0;
+          for (const auto& o : t.offsets) arm = std::max(arm, o.norm());
+        }
+        return t.inv_mass + arm * arm * t.inv_inertia.maxCoeff();
+      };
+      auto pair = [&](bool normal) {
+        return tb ? 2.0 * std::max(mob(ta, normal), mob(*tb, normal)) : mob(ta, normal);
+      };
+      const double g = std::max(cn * pair(true), ct * pair(false) / kTangentialGate);
+      if (g > gamma_one) gamma_one = g, one_what = what;
+    };
     std::vector<SphereSet> shapes;
     std::vector<ClumpInertia> inertias;
     for (const auto& t : w.types) {
@@ -308,34 +341,55 @@ World World::create(WorldSettings s) {
         const double mc =
             clump_contact_mass(shapes[t], inertias[t], shapes[u], inertias[u], dash_t);
         for (double r : w.types[t].radii)
-          for (double r2 : w.types[u].radii)
+          for (double r2 : w.types[u].radii) {
             consider(law, r * r2 / (r + r2), mst, mn, mc, "clump-clump");
+            consider_one(law, r * r2 / (r + r2), mst, w.types[t], &w.types[u],
+                         "clump-clump contact");
+          }
       }
       for (const auto& wd : w.walls) {
         const auto& law = w.law(w.types[t].material, wd.material);
         const double dash_t = std::sqrt(4.0 * law.g_star / law.e_star);
         const double mn = wall_contact_mass(shapes[t], inertias[t], 0.0);
         const double mc = wall_contact_mass(shapes[t], inertias[t], dash_t);
-        for (double r : w.types[t].radii)
+        for (double r : w.types[t].radii) {
           consider(law, r, w.types[t].mass, mn, mc, "clump-wall '" + wd.name + "'");
+          consider_one(law, r, w.types[t].mass, w.types[t], nullptr,
+                       "clump-wall '" + wd.name + "' contact");
+        }
       }
     }
     // The default time step honours all three limits: a fraction of the Rayleigh time, 10 steps
     // per impact, and the damping rate.
+    // With implicit damping on (the default) the damping of jammed clumps cannot overshoot at
+    // any step, so only a single contact's rate bounds the default step (docs/dem.md, implicit
+    // damping); without it, the stiffest contact mode's.
     if (s.time_step <= 0.0) {
       const double was = w.dt;
       if (tc_min / w.dt < kStepsPerImpact) w.dt = tc_min / kStepsPerImpact;
-      if (gamma_max * w.dt > kDampingLimit) w.dt = kDampingLimit / gamma_max;
-      if (w.dt < was)
-        w.warnings.push_back(
-            "time step " + fmt_g(w.dt) + " s instead of " + fmt_g(s.rayleigh_fraction) +
-            " x the Rayleigh time (" + fmt_g(was) + " s): " +
-            (w.dt * gamma_max >= kDampingLimit * (1.0 - 1e-12)
-                 ? "the contact damping of a " + gamma_what + " acts at a rate of " +
-                       fmt_g(gamma_max) + " /s, which needs steps of at most 1/rate"
-                 : "a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) + " m/s lasts " +
-                       fmt_g(tc_min) + " s, which needs 10 steps"));
+      if (implicit && gamma_one * w.dt > s.implicit_damping) w.dt = s.implicit_damping / gamma_one;
+      if (!implicit && gamma_max * w.dt > kDampingLimit) w.dt = kDampingLimit / gamma_max;
+      if (w.dt < was) {
+        std::string why = "a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) +
+                          " m/s lasts " + fmt_g(tc_min) + " s, which needs 10 steps";
+        if (implicit && w.dt * gamma_one >= s.implicit_damping * (1.0 - 1e-12))
+          why = "the dashpots of a single " + one_what + " damp at up to " + fmt_g(gamma_one) +
+                " /s, which needs steps of at most " + fmt_g(s.implicit_damping) + "/rate";
+        if (!implicit && w.dt * gamma_max >= kDampingLimit * (1.0 - 1e-12))
+          why = "the contact damping of a " + gamma_what + " acts at a rate of " +
+                fmt_g(gamma_max) + " /s, which needs steps of at most 1/rate";
+        w.warnings.push_back("time step " + fmt_g(w.dt) + " s instead of " +
+                             fmt_g(s.rayleigh_fraction) + " x the Rayleigh time (" + fmt_g(was) +
+                             " s): " + why);
+      }
     }
+    if (implicit && gamma_one * w.dt > s.implicit_damping)
+      w.warnings.push_back("the dashpots of a single " + one_what + " damp at up to " +
+                           fmt_g(gamma_one) + " /s: at the time step " + fmt_g(w.dt) +
+                           " s such contacts are damped implicitly (backward Euler), which "
+                           "dissipates differently from the explicit scheme their restitution "
+                           "is calibrated with (a step of " +
+                           fmt_g(s.implicit_damping / gamma_one) + " s would not)");
     const double per = tc_min / w.dt;
     if (per < 4.0)
       throw InputError(where, "time_step",
@@ -343,7 +397,7 @@ World World::create(WorldSettings s) {
                            tc_what + " impact at " + fmt_g(s.max_impact_speed) + " m/s lasts " +
                            fmt_g(tc_min) + " s, only " + fmt_g(per) +
                            " steps (at least 4 needed, 10 advised)");
-    if (gamma_max * w.dt >= 2.0)
+    if (!implicit && gamma_max * w.dt >= 2.0)
       throw InputError(where, "time_step",
                        "time step " + fmt_g(w.dt) + " s is above the stability limit of the " +
                            "contact damping: a " + gamma_what + " damps at a rate of " +
@@ -352,7 +406,7 @@ World World::create(WorldSettings s) {
     if (per < kStepsPerImpact)
       w.warnings.push_back("a " + tc_what + " impact at " + fmt_g(s.max_impact_speed) +
                            " m/s lasts only " + fmt_g(per) + " steps (10 or more advised)");
-    if (gamma_max * w.dt > kDampingLimit)
+    if (!implicit && gamma_max * w.dt > kDampingLimit)
       w.warnings.push_back("the contact damping of a " + gamma_what + " acts at a rate of " +
                            fmt_g(gamma_max) + " /s: the time step " + fmt_g(w.dt) +
                            " s is above 1/rate (a jammed pill was seen to blow up at 1.98/rate)");
@@ -534,6 +588,7 @@ std::uint64_t World::Impl::compute_fingerprint() const {
   }
   h.value(factories.size());
   h.value(settings.seed);
+  h.value(settings.implicit_damping);
   return h.h;
 }
 

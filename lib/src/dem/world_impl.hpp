@@ -124,6 +124,8 @@ struct World::Impl {
   std::vector<double> c_mroll;                  // standard rolling resistance: Σ μr R |Fn|, N m
   std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
   std::vector<Eigen::Vector3d> c_vp;            // predicted v(t) for damping (scratch)
+  std::vector<Eigen::Vector2d> c_damp;  // implicit damping: normal, tangential dashpot load, 1/s
+  std::vector<std::vector<int>> scratch_slot;  // implicit damping: per thread, clump -> slot
 
   // Sub-spheres.
   std::vector<int> s_clump;

@@ -33,6 +33,13 @@ const std::vector<RigInfo>& rig_catalogue() {
     // A speed-up, not physics: every Young's modulus times this factor (the scale sets it).
     const SettingInfo stiffness{
         "stiffness", {}, "1", "1", "factor on every Young's modulus (scale default; 1 = Table 1)"};
+    // The engine's implicit-damping gate (WorldSettings::implicit_damping); 0 = off, the time
+    // step then cut to the stiffest contact mode's damping rate as before session 10.
+    const SettingInfo damping{"implicit_damping",
+                              {"on", "off"},
+                              "",
+                              "on",
+                              "jammed pills damped implicitly (off: explicit, a smaller step)"};
     std::vector<RigInfo> r;
     r.push_back(
         {"bulk_density",
@@ -40,7 +47,7 @@ const std::vector<RigInfo>& rig_catalogue() {
          {{"bulk_density", Dimension::Density, "kg/m^3", 1.0, "mass in the cylinder / 0.26 L"}},
          {scale,
           {"wall", walls, "", "organic_glass", "material of the measuring cylinder"},
-          stiffness}});
+          stiffness, damping}});
     r.push_back({"angle_of_repose",
                  "lifting cylinder (200 mm/min) on a plate; heap angle from side silhouettes",
                  {{"angle", Dimension::Angle, "deg", deg, "mean of both flanks"},
@@ -50,7 +57,7 @@ const std::vector<RigInfo>& rig_catalogue() {
                   {"plate", walls, "", "galvanized_steel", "material of the base plate"},
                   {"lift_speed", {}, "mm/min", "200", "lifting speed of the cylinder"},
                   {"mass", {}, "kg", "0.5", "pill mass poured into the cylinder (scale default)"},
-                  stiffness}});
+                  stiffness, damping}});
     r.push_back({"discharge",
                  "hopper and 8-pocket wheel at a given speed",
                  {{"pocket_mass", Dimension::Mass, "kg", 1.0, "mean mass per pocket"},
@@ -65,7 +72,7 @@ const std::vector<RigInfo>& rig_catalogue() {
                    "100",
                    "length of the wheel slice along its axis (scale default; paper 100 mm)"},
                   {"pockets", {}, "1", "8", "pockets measured after the first (scale default)"},
-                  stiffness}});
+                  stiffness, damping}});
     return r;
   }();
   return rigs;

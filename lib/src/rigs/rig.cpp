@@ -87,6 +87,8 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
     if (*v > 1.0) throw InputError("--set", "stiffness", "must be <= 1 (1 = Table 1)");
     p.stiffness_scale = *v;
   }
+  if (const auto f = settings.find("implicit_damping"); f != settings.end())
+    p.implicit_damping = f->second == "off" ? 0.0 : dem::kImplicitDampingGate;
   if (auto v = num("lift_speed")) p.lift_speed = *v / 60000.0;
   if (auto v = num("mass")) p.heap_mass = *v;
   if (auto v = num("rpm")) p.rpm = *v;
@@ -122,6 +124,7 @@ nlohmann::json params_json(const ScaleParams& p) {
   return {{"name", p.name},
           {"stiffness_scale", p.stiffness_scale},
           {"rayleigh_fraction", p.rayleigh_fraction},
+          {"implicit_damping", p.implicit_damping},
           {"settle_speed_m_s", p.settle_speed},
           {"settle_max_s", p.settle_max},
           {"cup_diameter_m", p.cup_diameter},
@@ -190,6 +193,7 @@ dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& w
       ws.materials.add(m);
     }
   ws.rayleigh_fraction = c.p.rayleigh_fraction;
+  ws.implicit_damping = c.p.implicit_damping;
   ws.threads = c.req.threads;
   ws.seed = c.seed;
   ws.max_impact_speed = 2.5;
@@ -275,7 +279,9 @@ nlohmann::json profile_json(const Ctx& c, const dem::World& w, double sphere_ste
           {"contacts_s", pr.contacts},
           {"forces_s", pr.forces},
           {"checks_s", pr.checks},
-          {"sphere_steps_per_s", pr.total() > 0 ? sphere_steps / pr.total() : 0.0}};
+          {"sphere_steps_per_s", pr.total() > 0 ? sphere_steps / pr.total() : 0.0},
+          {"clump_steps", pr.clump_steps},
+          {"implicit_damping_clump_steps", pr.implicit_clump_steps}};
 }
 
 // Pills taken out by the pinch release: said once, and listed in the repeat's details.

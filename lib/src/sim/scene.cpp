@@ -199,6 +199,8 @@ Scene load_scene(const fs::path& path, const fs::path& data_dir) {
     w.rayleigh_fraction = *rf;
     doc.require_range("simulation.rayleigh_fraction", *rf, 0.0, 1.0, true);
   }
+  if (auto id = doc.boolean_opt("simulation.implicit_damping"))
+    w.implicit_damping = *id ? dem::kImplicitDampingGate : 0.0;
   if (auto v = doc.quantity_opt("simulation.max_impact_speed", Dimension::Velocity))
     w.max_impact_speed = *v;
   if (auto seed = doc.integer_opt("simulation.seed")) {

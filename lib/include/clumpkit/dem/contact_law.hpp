@@ -118,6 +118,11 @@ struct ContactForce {
   double roll_j = 0.0;
   double normal = 0.0;          ///< signed normal force (Hertz + damping + cohesion), N
   double elastic_energy = 0.0;  ///< stored in the springs, minus the cohesive well, J
+  /// The dashpots in effect this step, as linear coefficients on the relative velocity, N s/m:
+  /// normal c δ^¼ = 2√(5/6) β √(S_n m*), tangential 2√(5/6) β √(S_t m*) while the spring sticks
+  /// (0 when sliding, closing, or the effect is absent). The World's implicit damping uses them.
+  double dashpot_n = 0.0;
+  double dashpot_t = 0.0;
 };
 
 /// Evaluates the law for one contact over a step of `dt`, updating the history springs.

@@ -15,6 +15,10 @@ struct Profile {
   double output = 0.0;      ///< s, filled in by callers that write files
   long steps = 0;
   long neighbour_rebuilds = 0;
+  /// Implicit damping (WorldSettings::implicit_damping): clump-steps in all, and those whose
+  /// damping was integrated implicitly.
+  long clump_steps = 0;
+  long implicit_clump_steps = 0;
 
   double total() const {
     return integrate + walls + insert + neighbours + contacts + forces + checks + output;

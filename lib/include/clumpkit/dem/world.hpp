@@ -39,6 +39,18 @@ struct PairContactOverride {
   PairContact law;
 };
 
+/// The default gate of WorldSettings::implicit_damping (normal dashpots; docs/dem.md,
+/// implicit damping).
+inline constexpr double kImplicitDampingGate = 0.5;
+/// The tangential dashpots' gate relative to the normal ones' (WorldSettings::implicit_damping):
+/// the tangential damping uses the extrapolated velocity alone, whose pure-dashpot limit is
+/// Γ dt = 1, the normal impulse is telescoped, limit about 0.65 (docs/dem.md).
+inline constexpr double kTangentialGate = 1.6;
+
+/// Changes whenever the engine gives different results for the same input (caches of rig
+/// results key on it): 2 = session 10's implicit damping and the time step it allows.
+inline constexpr int kPhysicsRevision = 2;
+
 struct WorldSettings {
   /// Where the settings came from (scene file), used in InputError messages.
   std::string source = "world settings";
@@ -57,6 +69,18 @@ struct WorldSettings {
   /// least 10 steps (InputError below 4, warning below 10). At 0.2 T_R a 2 m/s pill-pill
   /// impact spans about 14 steps.
   double max_impact_speed = 2.0;
+  /// Implicit damping gate (docs/dem.md, "Implicit damping"). Each step, a clump's dashpot
+  /// loads L_n = Σ c_n (1/m + |r × n|²/I_min) and L_t = Σ c_t (1/m + |r|²/I_min) over its
+  /// contacts (pair contacts twice) bound how fast its contacts' damping acts; the engine's
+  /// explicit scheme overshoots above about 0.65/step (normal) and 1/step (tangential), and a
+  /// discharge run blew up with a single gate of 1 on max(c_n, c_t). A clump with L_n dt above
+  /// this gate or L_t dt above kTangentialGate times it has its damping integrated implicitly
+  /// in its own velocity (F_eff = M (M + w dt C)^-1 F, w in [1, 2), neighbours explicit), which
+  /// is stable for any step, so the default time step is no longer cut to the damping rate of the stiffest
+  /// contact mode (a jammed pill), only to a single contact's. Clumps below the gate are
+  /// untouched (bit-identical). 0 = off: the default step then keeps the stiffest mode's rate
+  /// below 1/step and a step above 2/rate is refused (as before session 10). In [0, 2].
+  double implicit_damping = kImplicitDampingGate;
   double skin = 0.0;  ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
   /// OpenMP threads; 0 = auto: all cores from 20 000 spheres on, one thread below (see
   /// docs/dem.md). Results are bit-identical for any thread count.
