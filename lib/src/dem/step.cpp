@@ -503,7 +503,8 @@ void World::Impl::compute_forces(double hdt) {
   const bool implicit = settings.implicit_damping > 0.0;
   if (implicit) {
     c_damp.resize(nc);
-    if (scratch_slot.size() < static_cast<size_t>(std::max(threads, 1))) scratch_slot.resize(std::max(threads, 1));
+    const size_t nt = static_cast<size_t>(std::max(threads, 1));
+    if (scratch_slot.size() < nt) scratch_slot.resize(nt), scratch_hot.resize(nt);
   }
   long n_implicit = 0;
   // One parallel region: clump kinematics, the pair and wall laws, then the sums. Each thread
@@ -637,7 +638,10 @@ void World::Impl::compute_forces(double hdt) {
       // then applies F_eff = M (M + dt C)^-1 F, with C the clump's damping matrix and F its
       // whole force and torque (gravity included, so a clump at rest stays at rest). Explicit
       // damping overshoots above a rate of about 1/step; this cannot (docs/dem.md).
-      std::vector<std::pair<int, Matrix6d>> hot;
+      // Per-thread scratch kept across steps (a fresh vector of 6×6 matrices every step was
+      // a large allocation per thread and step).
+      std::vector<std::pair<int, Matrix6d>>& hot = scratch_hot[t];
+      hot.clear();
       std::vector<int>& slot = scratch_slot[t];
       for (int c = c0; c < c1; ++c)
         if (c_damp[c].x() * dt > settings.implicit_damping ||

@@ -125,7 +125,8 @@ struct World::Impl {
   std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
   std::vector<Eigen::Vector3d> c_vp;            // predicted v(t) for damping (scratch)
   std::vector<Eigen::Vector2d> c_damp;  // implicit damping: normal, tangential dashpot load, 1/s
-  std::vector<std::vector<int>> scratch_slot;  // implicit damping: per thread, clump -> slot
+  std::vector<std::vector<int>> scratch_slot;
+  std::vector<std::vector<std::pair<int, Eigen::Matrix<double, 6, 6>>>> scratch_hot;  // per thread  // implicit damping: per thread, clump -> slot
 
   // Sub-spheres.
   std::vector<int> s_clump;
