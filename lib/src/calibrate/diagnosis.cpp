@@ -151,15 +151,24 @@ struct Surrogate {
   }
 };
 
-double chi2_of(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
-               double theta) {
-  double chi2 = 0;
+// Variance of each measurement's difference from the surrogate: the lab's and the
+// simulations' (the same for every theta of one fit).
+std::vector<double> fit_variances(const std::vector<Measurement>& ms, const Values& base,
+                                  const Surrogate& s) {
+  std::vector<double> var;
   for (const auto& m : ms) {
     const SimulatedValue& b = base.at(m.key());
-    const double var =
-        m.std * m.std / m.n + s.noise_var(m.key(), b.n > 0 ? b.std * b.std / b.n : 0.0);
-    const double d = s.value(m.key(), theta) - m.value;
-    chi2 += d * d / var;
+    var.push_back(m.std * m.std / m.n + s.noise_var(m.key(), b.n > 0 ? b.std * b.std / b.n : 0.0));
+  }
+  return var;
+}
+
+double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& var,
+               const Surrogate& s, double theta) {
+  double chi2 = 0;
+  for (size_t i = 0; i < ms.size(); ++i) {
+    const double d = s.value(ms[i].key(), theta) - ms[i].value;
+    chi2 += d * d / var[i];
   }
   return chi2;
 }
@@ -175,9 +184,10 @@ Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const 
   Fit f;
   f.chi2 = std::numeric_limits<double>::infinity();
   int best = 0;
+  const std::vector<double> var = fit_variances(ms, base, s);
   for (int i = 0; i <= n; ++i) {
     th[i] = lo + (hi - lo) * i / n;
-    c[i] = chi2_of(ms, base, s, th[i]);
+    c[i] = chi2_of(ms, var, s, th[i]);
     if (c[i] < f.chi2) {
       f.chi2 = c[i];
       best = i;

@@ -7,11 +7,6 @@
 
 namespace clumpkit::dem {
 
-namespace {
-// 2 √(5/6), the damping prefactor of the paper's eqs. (3) and (4).
-const double kDampingFactor = contact_damping_factor();
-}  // namespace
-
 const char* to_string(RollingModel m) {
   switch (m) {
     case RollingModel::kStandard:
@@ -130,8 +125,7 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
   double fn = f_hertz;
   if (law.damping) {
     // c δ^(1/4) δ̇ = dΦ/dt, Φ(δ) = (4/5) c δ^(5/4); δ̇ = −vdn.
-    const double c =
-        kDampingFactor * law.beta * std::sqrt(2.0 * law.e_star * std::sqrt(k.r_star) * k.m_star);
+    const double c = normal_dashpot_constant(law, k.r_star, k.m_star);
     out.dashpot_n = c * std::sqrt(std::sqrt(delta));
     if (dt > 0.0) {
       const double d_up = delta - 0.5 * dt * vdn;
@@ -171,7 +165,7 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
       ft *= cap / fs;
       h.shear = -ft / st;
     } else if (law.damping) {
-      out.dashpot_t = kDampingFactor * law.beta * std::sqrt(st * k.m_star);
+      out.dashpot_t = tangential_dashpot(law, st, k.m_star);
       ft -= out.dashpot_t * (vd - vdn * n);
     }
     out.force += ft;

@@ -26,10 +26,10 @@ std::string Profile::table() const {
   std::snprintf(buf, sizeof buf, "steps %ld, neighbour rebuilds %ld\n", steps, neighbour_rebuilds);
   s += buf;
   if (implicit_clump_steps > 0) {
-    std::snprintf(buf, sizeof buf, "implicit damping: %.3g %% of %ld clump-steps\n",
-                  100.0 * static_cast<double>(implicit_clump_steps) /
-                      static_cast<double>(clump_steps),
-                  clump_steps);
+    std::snprintf(
+        buf, sizeof buf, "implicit damping: %.3g %% of %ld clump-steps\n",
+        100.0 * static_cast<double>(implicit_clump_steps) / static_cast<double>(clump_steps),
+        clump_steps);
     s += buf;
   }
   return s;

@@ -73,14 +73,13 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 // triangle: c_t on every direction of the contact point's velocity v + ω × r, and c_n − c_t
 // more along the normal. For the isotropic part, Σ_e j_e j_eᵀ over the axes e with
 // j_e = (e, r × e) is [[I, −[r]ₓ], [[r]ₓ, |r|² I − r rᵀ]] in closed form.
-inline void add_dashpots(Matrix6d& c, const Eigen::Vector3d& r, const Eigen::Vector3d& n,
-                         double cn, double ct) {
+inline void add_dashpots(Matrix6d& c, const Eigen::Vector3d& r, const Eigen::Vector3d& n, double cn,
+                         double ct) {
   if (ct > 0.0) {
     const double r2 = r.squaredNorm();
     for (int i = 0; i < 3; ++i) {
       c(i, i) += ct;
-      for (int k = 0; k <= i; ++k)
-        c(3 + i, 3 + k) += ct * ((i == k ? r2 : 0.0) - r[i] * r[k]);
+      for (int k = 0; k <= i; ++k) c(3 + i, 3 + k) += ct * ((i == k ? r2 : 0.0) - r[i] * r[k]);
     }
     // Lower-left block (rows ω, columns v): [r]ₓ.
     c(3, 1) -= ct * r.z(), c(3, 2) += ct * r.y();
@@ -606,13 +605,15 @@ void World::Impl::compute_forces(double hdt) {
         c_f[ci] += pc.out.force;
         c_t[ci] += pc.moment_i;
         if (damped)
-          c_damp[ci] += 2.0 * dashpot_load(pc.out, types[c_type[ci]], pc.point - c_x[ci], pc.normal);
+          c_damp[ci] +=
+              2.0 * dashpot_load(pc.out, types[c_type[ci]], pc.point - c_x[ci], pc.normal);
       }
       if (own_j) {
         c_f[cj] -= pc.out.force;
         c_t[cj] -= pc.moment_j;
         if (damped)
-          c_damp[cj] += 2.0 * dashpot_load(pc.out, types[c_type[cj]], pc.point - c_x[cj], pc.normal);
+          c_damp[cj] +=
+              2.0 * dashpot_load(pc.out, types[c_type[cj]], pc.point - c_x[cj], pc.normal);
       }
       if (rolling) {
         if (own_i) c_t[ci] += pc.out.torque_i, c_mroll[ci] += pc.out.roll_i;
@@ -632,68 +633,7 @@ void World::Impl::compute_forces(double hdt) {
           c_damp[c] += dashpot_load(wc.out, types[c_type[c]], wc.point - c_x[c], wc.normal);
       }
     }
-    if (implicit && hdt > 0.0) {
-      // Implicit damping for the clumps whose dashpot load is above the gate: their own velocity
-      // enters their damping implicitly (backward Euler), the neighbours' explicitly. The step
-      // then applies F_eff = M (M + dt C)^-1 F, with C the clump's damping matrix and F its
-      // whole force and torque (gravity included, so a clump at rest stays at rest). Explicit
-      // damping overshoots above a rate of about 1/step; this cannot (docs/dem.md).
-      // Per-thread scratch kept across steps (a fresh vector of 6×6 matrices every step was
-      // a large allocation per thread and step).
-      std::vector<std::pair<int, Matrix6d>>& hot = scratch_hot[t];
-      hot.clear();
-      std::vector<int>& slot = scratch_slot[t];
-      for (int c = c0; c < c1; ++c)
-        if (c_damp[c].x() * dt > settings.implicit_damping ||
-            c_damp[c].y() * dt > kTangentialGate * settings.implicit_damping) {
-          if (slot.size() < static_cast<size_t>(nc)) slot.resize(nc, -1);
-          slot[c] = static_cast<int>(hot.size());
-          hot.push_back({c, Matrix6d::Zero()});
-        }
-      if (!hot.empty()) {
-        for (const PairContactData& pc : pair_contacts) {
-          if (pc.out.dashpot_n == 0.0 && pc.out.dashpot_t == 0.0) continue;
-          const PairEntry& p = pairs[pc.pair];
-          for (const int c : {s_clump[p.i], s_clump[p.j]})
-            if (mine(c) && slot[c] >= 0)
-              add_dashpots(hot[slot[c]].second, pc.point - c_x[c], pc.normal, pc.out.dashpot_n,
-                           pc.out.dashpot_t);
-        }
-        for (int s : wall_active) {
-          const int c = s_clump[s];
-          if (!mine(c) || slot[c] < 0) continue;
-          for (int k = 0; k < wall_contact_n[s]; ++k) {
-            const WallContactData& wc = wall_contacts[s][k];
-            add_dashpots(hot[slot[c]].second, wc.point - c_x[c], wc.normal, wc.out.dashpot_n,
-                         wc.out.dashpot_t);
-          }
-        }
-        for (auto& [c, cm] : hot) {
-          // (M + dt C) y = F in world coordinates, M = diag(m, m, m, R I Rᵀ); F_eff = M y.
-          const TypeData& ty = types[c_type[c]];
-          const Eigen::Matrix3d inertia =
-              c_R[c] * ty.inertia.asDiagonal() * c_R[c].transpose();
-          // The normal impulse is telescoped over two steps and the damping velocity is
-          // extrapolated: in a pure dashpot the scheme's fastest (alternating) mode responds to
-          // up to twice the coefficient, and the filter with C alone lets it grow once Γ dt is a
-          // few units. C is weighted 1 + σ/(1 + σ) (σ = the clump's load × dt ≥ Γ dt): about 1
-          // for gentle contacts, 2 for stiff jams (a scalar model of both schemes is stable for
-          // every Γ dt with this weight, docs/dem.md).
-          const double sigma = c_damp[c].maxCoeff() * dt;
-          Matrix6d a = (dt * (1.0 + sigma / (1.0 + sigma))) * cm;
-          a.diagonal().head<3>().array() += ty.mass;
-          a.bottomRightCorner<3, 3>() += inertia;
-          Vector6d f;
-          f.head<3>() = c_f[c] + ty.mass * settings.gravity;
-          f.tail<3>() = c_t[c];
-          const Vector6d y = a.llt().solve(f);
-          c_f[c] = ty.mass * y.head<3>() - ty.mass * settings.gravity;
-          c_t[c] = inertia * y.tail<3>();
-          slot[c] = -1;
-          ++n_implicit;
-        }
-      }
-    }
+    if (implicit && hdt > 0.0) n_implicit += damp_implicitly(c0, c1, t);
     if (t == 0) {
       for (const PairContactData& pc : pair_contacts) elastic += pc.out.elastic_energy;
       for (int s : wall_active)
@@ -712,6 +652,68 @@ void World::Impl::compute_forces(double hdt) {
     profile.clump_steps += nc;
     profile.implicit_clump_steps += n_implicit;
   }
+}
+
+// Implicit damping for the clumps [c0, c1) whose dashpot load is above the gate (their loads
+// are in c_damp, their summed force and torque in c_f, c_t): their own velocity enters their
+// damping implicitly (backward Euler), the neighbours' explicitly. The step then applies
+// F_eff = M (M + w dt C)^-1 F, with C the clump's damping matrix and F its whole force and
+// torque (gravity included, so a clump at rest stays at rest). Explicit damping overshoots above
+// a rate of about 1/step; this cannot (docs/dem.md). Returns the number of clumps treated.
+long World::Impl::damp_implicitly(int c0, int c1, int thread) {
+  // Per-thread scratch kept across steps (a fresh vector of 6×6 matrices every step was a
+  // large allocation per thread and step).
+  std::vector<std::pair<int, Matrix6d>>& hot = scratch_hot[thread];
+  std::vector<int>& slot = scratch_slot[thread];
+  hot.clear();
+  for (int c = c0; c < c1; ++c)
+    if (c_damp[c].x() * dt > settings.implicit_damping ||
+        c_damp[c].y() * dt > kTangentialGate * settings.implicit_damping) {
+      if (slot.size() < c_x.size()) slot.resize(c_x.size(), -1);
+      slot[c] = static_cast<int>(hot.size());
+      hot.push_back({c, Matrix6d::Zero()});
+    }
+  if (hot.empty()) return 0;
+  auto hot_slot = [&](int c) { return c >= c0 && c < c1 ? slot[c] : -1; };
+  for (const PairContactData& pc : pair_contacts) {
+    if (pc.out.dashpot_n == 0.0 && pc.out.dashpot_t == 0.0) continue;
+    const PairEntry& p = pairs[pc.pair];
+    for (const int c : {s_clump[p.i], s_clump[p.j]})
+      if (const int k = hot_slot(c); k >= 0)
+        add_dashpots(hot[k].second, pc.point - c_x[c], pc.normal, pc.out.dashpot_n,
+                     pc.out.dashpot_t);
+  }
+  for (int s : wall_active) {
+    const int c = s_clump[s], k = hot_slot(c);
+    if (k < 0) continue;
+    for (int w = 0; w < wall_contact_n[s]; ++w) {
+      const WallContactData& wc = wall_contacts[s][w];
+      add_dashpots(hot[k].second, wc.point - c_x[c], wc.normal, wc.out.dashpot_n, wc.out.dashpot_t);
+    }
+  }
+  for (auto& [c, cm] : hot) {
+    // (M + w dt C) y = F in world coordinates, M = diag(m, m, m, R I Rᵀ); F_eff = M y.
+    const TypeData& ty = types[c_type[c]];
+    const Eigen::Matrix3d inertia = c_R[c] * ty.inertia.asDiagonal() * c_R[c].transpose();
+    // The normal impulse is telescoped over two steps and the damping velocity is
+    // extrapolated: in a pure dashpot the scheme's fastest (alternating) mode responds to up to
+    // twice the coefficient, and the filter with C alone lets it grow once Γ dt is a few units.
+    // C is weighted w = 1 + σ/(1 + σ) (σ = the clump's load × dt ≥ Γ dt): about 1 for gentle
+    // contacts, 2 for stiff jams (a scalar model of both schemes is stable for every Γ dt with
+    // this weight: bench/damping_schemes.py).
+    const double sigma = c_damp[c].maxCoeff() * dt;
+    Matrix6d a = (dt * (1.0 + sigma / (1.0 + sigma))) * cm;
+    a.diagonal().head<3>().array() += ty.mass;
+    a.bottomRightCorner<3, 3>() += inertia;
+    Vector6d f;
+    f.head<3>() = c_f[c] + ty.mass * settings.gravity;
+    f.tail<3>() = c_t[c];
+    const Vector6d y = a.llt().solve(f);
+    c_f[c] = ty.mass * y.head<3>() - ty.mass * settings.gravity;
+    c_t[c] = inertia * y.tail<3>();
+    slot[c] = -1;
+  }
+  return static_cast<long>(hot.size());
 }
 
 void World::Impl::release_pinched(World& world) {

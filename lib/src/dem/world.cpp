@@ -287,10 +287,10 @@ World World::create(WorldSettings s) {
                             const TypeData& ta, const TypeData* tb, const std::string& what) {
       if (!law.damping) return;
       const double d = hertz_max_overlap(law.e_star, r_star, m_star, s.max_impact_speed);
-      const double k = contact_damping_factor() * law.beta;
-      const double cn = k * std::sqrt(2.0 * law.e_star * std::sqrt(r_star * d) * m_star);
+      const double cn = normal_dashpot_constant(law, r_star, m_star) * std::sqrt(std::sqrt(d));
       const double ct =
-          law.friction ? k * std::sqrt(8.0 * law.g_star * std::sqrt(r_star * d) * m_star) : 0.0;
+          law.friction ? tangential_dashpot(law, 8.0 * law.g_star * std::sqrt(r_star * d), m_star)
+                       : 0.0;
       // Any direction: the lever arm reaches the bounding radius; along the normal only the
       // sphere centre's offset turns the clump (r × n = offset × n).
       auto mob = [](const TypeData& t, bool normal) {
@@ -324,7 +324,7 @@ World World::create(WorldSettings s) {
       if (tc < tc_min)
         tc_min = tc,
         tc_what = what + " (stiffest contact mode: " + percent(mn, m_star) + " % of the mass)";
-      if (!law.damping) return;
+      if (!law.damping || mc <= 0.0) return;
       const double stiffness =
           2.0 * law.e_star * std::sqrt(r_star * hertz_max_overlap(law.e_star, r_star, mn, v));
       const double gamma = contact_damping_factor() * law.beta * std::sqrt(stiffness * m_star) / mc;
@@ -338,8 +338,10 @@ World World::create(WorldSettings s) {
         const double mst = w.types[t].mass * w.types[u].mass / (w.types[t].mass + w.types[u].mass);
         const double dash_t = std::sqrt(4.0 * law.g_star / law.e_star);  // c_t / c_n
         const double mn = clump_contact_mass(shapes[t], inertias[t], shapes[u], inertias[u], 0.0);
+        // The dashpots' mode mass only sets the explicit scheme's limit (implicit damping off).
         const double mc =
-            clump_contact_mass(shapes[t], inertias[t], shapes[u], inertias[u], dash_t);
+            implicit ? 0.0
+                     : clump_contact_mass(shapes[t], inertias[t], shapes[u], inertias[u], dash_t);
         for (double r : w.types[t].radii)
           for (double r2 : w.types[u].radii) {
             consider(law, r * r2 / (r + r2), mst, mn, mc, "clump-clump");
@@ -351,7 +353,7 @@ World World::create(WorldSettings s) {
         const auto& law = w.law(w.types[t].material, wd.material);
         const double dash_t = std::sqrt(4.0 * law.g_star / law.e_star);
         const double mn = wall_contact_mass(shapes[t], inertias[t], 0.0);
-        const double mc = wall_contact_mass(shapes[t], inertias[t], dash_t);
+        const double mc = implicit ? 0.0 : wall_contact_mass(shapes[t], inertias[t], dash_t);
         for (double r : w.types[t].radii) {
           consider(law, r, w.types[t].mass, mn, mc, "clump-wall '" + wd.name + "'");
           consider_one(law, r, w.types[t].mass, w.types[t], nullptr,

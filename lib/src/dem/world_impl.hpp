@@ -126,7 +126,8 @@ struct World::Impl {
   std::vector<Eigen::Vector3d> c_vp;            // predicted v(t) for damping (scratch)
   std::vector<Eigen::Vector2d> c_damp;  // implicit damping: normal, tangential dashpot load, 1/s
   std::vector<std::vector<int>> scratch_slot;
-  std::vector<std::vector<std::pair<int, Eigen::Matrix<double, 6, 6>>>> scratch_hot;  // per thread  // implicit damping: per thread, clump -> slot
+  std::vector<std::vector<std::pair<int, Eigen::Matrix<double, 6, 6>>>>
+      scratch_hot;  // per thread  // implicit damping: per thread, clump -> slot
 
   // Sub-spheres.
   std::vector<int> s_clump;
@@ -200,6 +201,7 @@ struct World::Impl {
   void compute_forces(double history_dt);
   void kick();
   void check_health();
+  long damp_implicitly(int c0, int c1, int thread);  // step.cpp, in the forces' region
   void release_pinched(World& world);
   void update_spheres(int first_clump);
 

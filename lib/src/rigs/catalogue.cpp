@@ -47,7 +47,8 @@ const std::vector<RigInfo>& rig_catalogue() {
          {{"bulk_density", Dimension::Density, "kg/m^3", 1.0, "mass in the cylinder / 0.26 L"}},
          {scale,
           {"wall", walls, "", "organic_glass", "material of the measuring cylinder"},
-          stiffness, damping}});
+          stiffness,
+          damping}});
     r.push_back({"angle_of_repose",
                  "lifting cylinder (200 mm/min) on a plate; heap angle from side silhouettes",
                  {{"angle", Dimension::Angle, "deg", deg, "mean of both flanks"},
@@ -57,7 +58,8 @@ const std::vector<RigInfo>& rig_catalogue() {
                   {"plate", walls, "", "galvanized_steel", "material of the base plate"},
                   {"lift_speed", {}, "mm/min", "200", "lifting speed of the cylinder"},
                   {"mass", {}, "kg", "0.5", "pill mass poured into the cylinder (scale default)"},
-                  stiffness, damping}});
+                  stiffness,
+                  damping}});
     r.push_back({"discharge",
                  "hopper and 8-pocket wheel at a given speed",
                  {{"pocket_mass", Dimension::Mass, "kg", 1.0, "mean mass per pocket"},
@@ -72,7 +74,8 @@ const std::vector<RigInfo>& rig_catalogue() {
                    "100",
                    "length of the wheel slice along its axis (scale default; paper 100 mm)"},
                   {"pockets", {}, "1", "8", "pockets measured after the first (scale default)"},
-                  stiffness, damping}});
+                  stiffness,
+                  damping}});
     return r;
   }();
   return rigs;

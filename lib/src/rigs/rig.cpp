@@ -88,7 +88,7 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
     p.stiffness_scale = *v;
   }
   if (const auto f = settings.find("implicit_damping"); f != settings.end())
-    p.implicit_damping = f->second == "off" ? 0.0 : dem::kImplicitDampingGate;
+    p.implicit_damping = f->second == "on";
   if (auto v = num("lift_speed")) p.lift_speed = *v / 60000.0;
   if (auto v = num("mass")) p.heap_mass = *v;
   if (auto v = num("rpm")) p.rpm = *v;
@@ -193,7 +193,7 @@ dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& w
       ws.materials.add(m);
     }
   ws.rayleigh_fraction = c.p.rayleigh_fraction;
-  ws.implicit_damping = c.p.implicit_damping;
+  ws.implicit_damping = c.p.implicit_damping ? dem::kImplicitDampingGate : 0.0;
   ws.threads = c.req.threads;
   ws.seed = c.seed;
   ws.max_impact_speed = 2.5;

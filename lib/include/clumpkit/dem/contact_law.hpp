@@ -4,6 +4,7 @@
 /// the physics at all (no spring, no history, no torque); a present effect with a zero value is
 /// still evaluated. The calibration module switches effects per pair (SPEC §8).
 #include <Eigen/Core>
+#include <cmath>
 #include <optional>
 #include <string>
 
@@ -130,6 +131,17 @@ struct ContactForce {
 /// The paper's damping prefactor 2√(5/6): c_n = 2√(5/6) β √(S_n m*), eq. (3).
 inline double contact_damping_factor() {
   return 1.8257418583505538;
+}
+
+/// The constant c of eq. (3)'s normal dashpot c δ^(1/4): 2√(5/6) β √(2 Y* √R* m*).
+inline double normal_dashpot_constant(const ResolvedContact& law, double r_star, double m_star) {
+  return contact_damping_factor() * law.beta *
+         std::sqrt(2.0 * law.e_star * std::sqrt(r_star) * m_star);
+}
+
+/// The tangential dashpot of eq. (4) on a spring of stiffness S_t: 2√(5/6) β √(S_t m*), N s/m.
+inline double tangential_dashpot(const ResolvedContact& law, double s_t, double m_star) {
+  return contact_damping_factor() * law.beta * std::sqrt(s_t * m_star);
 }
 
 /// The normal damping force of eq. (3), c δ^(1/4) δ̇ with c = 2√(5/6) β √(2 Y* √R* m*), is the

@@ -76,8 +76,8 @@ struct WorldSettings {
   /// discharge run blew up with a single gate of 1 on max(c_n, c_t). A clump with L_n dt above
   /// this gate or L_t dt above kTangentialGate times it has its damping integrated implicitly
   /// in its own velocity (F_eff = M (M + w dt C)^-1 F, w in [1, 2), neighbours explicit), which
-  /// is stable for any step, so the default time step is no longer cut to the damping rate of the stiffest
-  /// contact mode (a jammed pill), only to a single contact's. Clumps below the gate are
+  /// is stable for any step, so the default time step is no longer cut to the damping rate of the
+  /// stiffest contact mode (a jammed pill), only to a single contact's. Clumps below the gate are
   /// untouched (bit-identical). 0 = off: the default step then keeps the stiffest mode's rate
   /// below 1/step and a step above 2/rate is refused (as before session 10). In [0, 2].
   double implicit_damping = kImplicitDampingGate;

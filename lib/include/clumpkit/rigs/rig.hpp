@@ -25,7 +25,7 @@ namespace clumpkit::rigs {
 struct ScaleParams {
   std::string name;                ///< tiny | mini | small | paper
   double stiffness_scale = 1.0;    ///< factor on every Young's modulus (speed-up, see docs)
-  double implicit_damping = 0.5;   ///< engine implicit-damping gate (dem::kImplicitDampingGate)
+  bool implicit_damping = true;    ///< engine implicit damping at its default gate (--set)
   double rayleigh_fraction = 0.2;  ///< time step / Rayleigh time
   double settle_speed = 0.005;     ///< m/s, RMS clump speed below which a bed is at rest
   double settle_max = 2.0;         ///< s of simulated time allowed for one settle
