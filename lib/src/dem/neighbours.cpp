@@ -53,8 +53,10 @@ void World::Impl::rebuild_neighbours() {
   const int ns = static_cast<int>(s_r.size());
   const double h = cell > 0.0 ? cell : 1.0;
 
-  // Spheres sorted by cell.
-  std::vector<std::pair<std::uint64_t, int>> bins(ns);
+  // Spheres sorted by cell, with their positions, radii and clumps copied in that order (the
+  // candidates of one cell column are then contiguous in memory).
+  std::vector<std::pair<std::uint64_t, int>>& bins = scratch_bins;
+  bins.resize(ns);
   std::vector<std::array<std::int64_t, 3>> sc(ns);
 #pragma omp parallel for num_threads(threads) schedule(static) if (ns >= kParallelMin)
   for (int s = 0; s < ns; ++s) {
@@ -62,35 +64,58 @@ void World::Impl::rebuild_neighbours() {
     bins[s] = {cell_key(sc[s][0], sc[s][1], sc[s][2]), s};
   }
   std::sort(bins.begin(), bins.end());
+  std::vector<std::uint64_t> keys(ns);
+  std::vector<Eigen::Vector4d> sorted(ns);  // x, y, z, r
+  std::vector<int> sorted_clump(ns);
+  // Runs of one cell: [runs[k], runs[k + 1]) in the sorted bins.
+  std::vector<int> runs;
+  runs.reserve(ns / 2 + 2);
+  for (int k = 0; k < ns; ++k) {
+    const int s = bins[k].second;
+    keys[k] = bins[k].first;
+    sorted[k] << s_pos[s], s_r[s];
+    sorted_clump[k] = s_clump[s];
+    if (k == 0 || keys[k] != keys[k - 1]) runs.push_back(k);
+  }
+  const int nruns = static_cast<int>(runs.size());
+  runs.push_back(ns);
   // The three cells (x, y, z−1 … z+1) are consecutive keys (z is the low field), so each of
-  // the nine (dx, dy) columns is one binary search and one contiguous run of the sorted bins.
+  // the nine (dx, dy) columns around a cell is one binary search and one contiguous run of the
+  // sorted bins, looked up once per occupied cell.
   auto column = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-    auto lo = std::lower_bound(bins.begin(), bins.end(), std::make_pair(cell_key(x, y, z - 1), -1));
+    const int lo = static_cast<int>(
+        std::lower_bound(keys.begin(), keys.end(), cell_key(x, y, z - 1)) - keys.begin());
     const std::uint64_t last = cell_key(x, y, z + 1);
-    auto hi = lo;
-    while (hi != bins.end() && hi->first <= last) ++hi;
-    return std::make_pair(lo, hi);
+    int hi = lo;
+    while (hi < ns && keys[hi] <= last) ++hi;
+    return std::array<int, 2>{lo, hi};
   };
 
   // Sphere pairs, per sphere i the sorted list of j > i (lists kept between rebuilds so their
   // storage is reused).
   std::vector<std::vector<int>>& near = scratch_near;
   near.resize(ns);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
-  for (int i = 0; i < ns; ++i) {
-    auto& out = near[i];
-    out.clear();
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy) {
-        auto [lo, hi] = column(sc[i][0] + dx, sc[i][1] + dy, sc[i][2]);
-        for (auto it = lo; it != hi; ++it) {
-          const int j = it->second;
-          if (j <= i || s_clump[j] == s_clump[i]) continue;
-          const double rr = s_r[i] + s_r[j] + skin;
-          if ((s_pos[i] - s_pos[j]).squaredNorm() < rr * rr) out.push_back(j);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (ns >= kParallelMin)
+  for (int r = 0; r < nruns; ++r) {
+    const std::array<std::int64_t, 3>& c = sc[bins[runs[r]].second];
+    std::array<std::array<int, 2>, 9> cols;
+    for (int dx = -1, n = 0; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) cols[n++] = column(c[0] + dx, c[1] + dy, c[2]);
+    for (int k = runs[r]; k < runs[r + 1]; ++k) {
+      const int i = bins[k].second;
+      const Eigen::Vector4d& pi = sorted[k];
+      const int ci = sorted_clump[k];
+      auto& out = near[i];
+      out.clear();
+      for (const auto& [lo, hi] : cols)
+        for (int m = lo; m < hi; ++m) {
+          const int j = bins[m].second;
+          if (j <= i || sorted_clump[m] == ci) continue;
+          const double rr = pi[3] + sorted[m][3] + skin;
+          if ((pi.head<3>() - sorted[m].head<3>()).squaredNorm() < rr * rr) out.push_back(j);
         }
-      }
-    std::sort(out.begin(), out.end());
+      std::sort(out.begin(), out.end());
+    }
   }
   std::vector<PairEntry> next;
   next.reserve(pairs.size() + pairs.size() / 8);
@@ -141,27 +166,36 @@ void World::Impl::rebuild_neighbours() {
   }
   std::vector<char> at_rest(nw);
   for (int wi = 0; wi < nw; ++wi) at_rest[wi] = walls[wi].state.pose.at_rest();
-  std::vector<std::vector<std::array<int, 2>>> cand(ns);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64) if (ns >= kParallelMin)
-  for (int s = 0; s < ns; ++s) {
-    const double reach = s_r[s] + skin;
+  std::vector<std::vector<std::array<int, 2>>>& cand = scratch_cand;
+  cand.resize(ns);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (ns >= kParallelMin)
+  for (int r = 0; r < nruns; ++r) {
+    for (int k = runs[r]; k < runs[r + 1]; ++k) cand[bins[k].second].clear();
     for (int wi = 0; wi < nw; ++wi) {
       const auto& bins_w = tri_bins[wi];
       if (bins_w.empty()) continue;
-      std::uint64_t key;
-      if (at_rest[wi]) {
-        key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
-      } else {
-        const Eigen::Vector3d x = walls[wi].state.pose.unapply(s_pos[s]);
-        key = cell_key(cell_of(x.x(), h), cell_of(x.y(), h), cell_of(x.z(), h));
-      }
       const WallData& wd = walls[wi];
-      auto lo = std::lower_bound(bins_w.begin(), bins_w.end(), std::make_pair(key, -1));
-      for (auto it = lo; it != bins_w.end() && it->first == key; ++it) {
-        const auto& t = wd.triangles[it->second];
-        const Eigen::Vector3d c = closest_point_on_triangle(s_pos[s], wd.vertices[t[0]],
-                                                            wd.vertices[t[1]], wd.vertices[t[2]]);
-        if ((c - s_pos[s]).squaredNorm() < reach * reach) cand[s].push_back({wi, it->second});
+      auto lookup = [&](std::uint64_t key) {
+        return std::lower_bound(bins_w.begin(), bins_w.end(), std::make_pair(key, -1));
+      };
+      // A wall at rest: one lookup for the cell (its frame is the world's).
+      const auto rest_lo = at_rest[wi] ? lookup(keys[runs[r]]) : bins_w.end();
+      for (int k = runs[r]; k < runs[r + 1]; ++k) {
+        const int s = bins[k].second;
+        std::uint64_t key = keys[k];
+        auto lo = rest_lo;
+        if (!at_rest[wi]) {
+          const Eigen::Vector3d x = wd.state.pose.unapply(s_pos[s]);
+          key = cell_key(cell_of(x.x(), h), cell_of(x.y(), h), cell_of(x.z(), h));
+          lo = lookup(key);
+        }
+        const double reach = s_r[s] + skin;
+        for (auto it = lo; it != bins_w.end() && it->first == key; ++it) {
+          const auto& t = wd.triangles[it->second];
+          const Eigen::Vector3d c = closest_point_on_triangle(s_pos[s], wd.vertices[t[0]],
+                                                              wd.vertices[t[1]], wd.vertices[t[2]]);
+          if ((c - s_pos[s]).squaredNorm() < reach * reach) cand[s].push_back({wi, it->second});
+        }
       }
     }
   }

@@ -3,9 +3,8 @@
 // (Dullweber, Leimkuhler & McLachlan 1997), which keeps the gyroscopic term exact per sub-step.
 #include <omp.h>
 
-#include <Eigen/Cholesky>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -38,6 +37,13 @@ void rotate_momentum(Eigen::Vector3d& pi, int k, double c, double s) {
 // last bit (the next terms are below 1e-20 relative) and costs a fraction of a libm sincos,
 // which this stage called five times per clump and step.
 inline void half_angle_sincos(double x, double& s, double& c) {
+  if (std::abs(x) < 1e-3) {
+    // The usual case (ω dt / 4 ~ 1e-4): the terms after x^5 / x^4 are below 1e-20 relative.
+    const double x2 = x * x;
+    s = x * (1.0 - x2 * (1.0 / 6) * (1.0 - x2 * (1.0 / 20)));
+    c = 1.0 - x2 * 0.5 * (1.0 - x2 * (1.0 / 12));
+    return;
+  }
   if (std::abs(x) < 0.01) {
     const double x2 = x * x;
     s = x * (1.0 - x2 * (1.0 / 6) *
@@ -91,8 +97,44 @@ inline void add_dashpots(Matrix6d& c, const Eigen::Vector3d& r, const Eigen::Vec
     Vector6d j;
     j.head<3>() = n;
     j.tail<3>() = r.cross(n);
-    c.selfadjointView<Eigen::Lower>().rankUpdate(j, k);
+    // Rank-one update k j jᵀ of the lower triangle, written out (Eigen's selfadjoint rank
+    // update is a generic routine that cost more than the rest of the assembly).
+    for (int col = 0; col < 6; ++col) {
+      const double kj = k * j[col];
+      for (int row = col; row < 6; ++row) c(row, col) += kj * j[row];
+    }
   }
+}
+
+// Solves A y = f for a symmetric positive definite A given by its lower triangle, by LDLᵀ
+// (unit lower L overwriting the strict lower triangle), fixed size and inline: the solve of
+// every implicitly damped clump and step. Six reciprocals and no square root: a Cholesky's
+// chain of square roots and divisions cost as much as assembling the matrix.
+inline Vector6d solve_spd(Matrix6d& a, const Vector6d& f) {
+  std::array<double, 6> dd, inv_d;
+  for (int col = 0; col < 6; ++col) {
+    // Row col of L D (entries k < col) into the column's scratch: a(col, k) · d_k.
+    std::array<double, 6> ld;
+    double d = a(col, col);
+    for (int k = 0; k < col; ++k) {
+      ld[k] = a(col, k) * dd[k];
+      d -= a(col, k) * ld[k];
+    }
+    dd[col] = d;
+    inv_d[col] = 1.0 / d;
+    for (int row = col + 1; row < 6; ++row) {
+      double v = a(row, col);
+      for (int k = 0; k < col; ++k) v -= a(row, k) * ld[k];
+      a(row, col) = v * inv_d[col];
+    }
+  }
+  Vector6d y = f;
+  for (int i = 1; i < 6; ++i)
+    for (int k = 0; k < i; ++k) y[i] -= a(i, k) * y[k];
+  for (int i = 0; i < 6; ++i) y[i] *= inv_d[i];
+  for (int i = 4; i >= 0; --i)
+    for (int k = i + 1; k < 6; ++k) y[i] -= a(k, i) * y[k];
+  return y;
 }
 
 }  // namespace
@@ -182,11 +224,12 @@ void World::Impl::kick_and_drift() {
   const int ns = static_cast<int>(s_r.size());
   const double h = 0.5 * dt;
   double ds = 0.0;
-  // One parallel region for the clumps and then their spheres (fewer fork-joins per step); the
-  // spheres' largest displacement since the last neighbour rebuild comes along for free.
+  // One loop over the clumps, each moving its own spheres (fewer fork-joins per step, no
+  // gather of clump poses per sphere); the spheres' largest displacement since the last
+  // neighbour rebuild comes along for free.
 #pragma omp parallel num_threads(threads) if (ns >= kParallelMin)
   {
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) reduction(max : ds)
     for (int c = 0; c < nc; ++c) {
       half_kick(*this, c, h);
       c_x[c] += dt * c_v[c];
@@ -217,14 +260,16 @@ void World::Impl::kick_and_drift() {
       Eigen::Quaterniond q(qw, qv.x(), qv.y(), qv.z());
       q.normalize();
       c_q[c] = q;
-      c_R[c] = q.toRotationMatrix();
+      const Eigen::Matrix3d R = q.toRotationMatrix();
+      c_R[c] = R;
       c_wb[c] = pi.cwiseProduct(t.inv_inertia);
-    }
-#pragma omp for schedule(static) reduction(max : ds)
-    for (int s = 0; s < ns; ++s) {
-      const int c = s_clump[s];
-      s_pos[s] = c_x[c] + c_R[c] * s_off[s];
-      ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+      // The clump's spheres (contiguous) follow while its pose is at hand.
+      const Eigen::Vector3d& x = c_x[c];
+      const int s1 = c + 1 < nc ? c_first[c + 1] : ns;
+      for (int s = c_first[c]; s < s1; ++s) {
+        s_pos[s] = x + R * s_off[s];
+        ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+      }
     }
   }
   drift_disp2 = ds;
@@ -491,36 +536,85 @@ void World::Impl::detect_contacts() {
 void World::Impl::compute_forces(double hdt) {
   const int nc = static_cast<int>(c_x.size());
   const int npc = static_cast<int>(pair_contacts.size());
-  const int na = static_cast<int>(wall_active.size());
   c_ww.resize(nc);
   c_vp.resize(nc);
   for (WallData& wd : walls) {
     wd.state.force.setZero();
     wd.state.torque.setZero();
   }
+  const int na = static_cast<int>(wall_active.size());
   elastic = 0.0;
   const bool implicit = settings.implicit_damping > 0.0;
-  if (implicit) {
-    c_damp.resize(nc);
-    const size_t nt = static_cast<size_t>(std::max(threads, 1));
-    if (scratch_slot.size() < nt) scratch_slot.resize(nt), scratch_hot.resize(nt);
-  }
+  if (implicit) c_damp.resize(nc);
   long n_implicit = 0;
-  // One parallel region: clump kinematics, the pair and wall laws, then the sums. Each thread
-  // sums the forces of its own block of clumps, visiting the contacts in list order (pairs by
-  // (i, j), then spheres by index), so every clump's sum is the same sequence of additions for
-  // any thread count; thread 0 also adds up the walls' loads and the energies.
-#pragma omp parallel num_threads(threads) if (npc + static_cast <int>(s_r.size()) >= kParallelMin) reduction(+ : n_implicit)
+  // Per-clump index of the pair contacts. The list is sorted by (i, j) and spheres by clump,
+  // so clump c's contacts as sphere i are one range [i_start[c], i_start[c + 1]); its
+  // contacts as sphere j (all before those, since j's clump comes after i's) are listed in
+  // j_list[j_start[c] ...], in list order (a stable counting sort by j's clump, each thread
+  // counting and filling its own block of the list).
+  const bool parallel = npc + static_cast<int>(s_r.size()) >= kParallelMin;
+  const int nt_all = parallel ? std::max(threads, 1) : 1;
+  std::vector<int>& i_start = scratch_i_start;
+  std::vector<int>& j_start = scratch_j_start;
+  std::vector<int>& j_list = scratch_j_list;
+  constexpr int kEnergyBlock = 1024;
+  const int nblocks = (npc + kEnergyBlock - 1) / kEnergyBlock;
+  std::vector<double>& block_energy = scratch_block_energy;
+  block_energy.resize(nblocks);
+  std::vector<std::vector<int>>& j_count = scratch_j_count;
+  i_start.resize(nc + 1);
+  j_start.resize(nc + 1);
+  j_list.resize(npc);
+  j_count.resize(nt_all);
+  auto clump_i = [&](int k) { return s_clump[pairs[pair_contacts[k].pair].i]; };
+  auto clump_j = [&](int k) { return s_clump[pairs[pair_contacts[k].pair].j]; };
+  // One parallel region: clump kinematics and the contact index, the pair and wall laws, then
+  // the sums. The laws and the sums are shared out dynamically (the cost per contact and per
+  // clump varies along the lists: jammed clumps at the bottom of a bed need the implicit
+  // solve); every clump's sum is done by one thread, visiting its contacts in list order
+  // (pairs by (i, j), then its spheres' wall contacts by sphere), so it is the same sequence
+  // of additions for any thread count.
+#pragma omp parallel num_threads(nt_all) if (parallel) reduction(+ : n_implicit)
   {
-#pragma omp for schedule(static)
+    const int nt = omp_get_num_threads(), t = omp_get_thread_num();
+    const int k0 = static_cast<int>(std::int64_t(npc) * t / nt);
+    const int k1 = static_cast<int>(std::int64_t(npc) * (t + 1) / nt);
+#pragma omp for schedule(static) nowait
     for (int c = 0; c < nc; ++c) {
       c_ww[c] = c_R[c] * c_wb[c];
       // Predicted v(t) from the half-step velocity and the last forces, for the damping terms:
       // halves the restitution error at the default step (0.2 T_R).
       c_vp[c] = c_v[c] + (0.5 * dt) * (types[c_type[c]].inv_mass * c_f[c] + settings.gravity);
     }
+    // The index, over this thread's block of the list: where each clump's i-range starts (a
+    // clump c is written by the block holding the first contact with clump i >= c), and how
+    // many contacts each clump has as j.
+    std::vector<int>& count = j_count[t];
+    count.assign(nc + 1, 0);
+    for (int k = k0; k < k1; ++k) {
+      const int ci = clump_i(k);
+      for (int c = k == 0 ? 0 : clump_i(k - 1) + 1; c <= ci; ++c) i_start[c] = k;
+      ++count[clump_j(k)];
+    }
+    if (t == nt - 1)
+      for (int c = npc == 0 ? 0 : clump_i(npc - 1) + 1; c <= nc; ++c) i_start[c] = npc;
+#pragma omp barrier
+#pragma omp single
+    {
+      int at = 0;
+      for (int c = 0; c < nc; ++c) {
+        j_start[c] = at;
+        for (int u = 0; u < nt; ++u) {
+          const int n = j_count[u][c];
+          j_count[u][c] = at;  // from here on: where thread u writes clump c's next entry
+          at += n;
+        }
+      }
+      j_start[nc] = at;
+    }
+    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;
 
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, 256) nowait
     for (int k = 0; k < npc; ++k) {
       PairContactData& pc = pair_contacts[k];
       const PairEntry& p = pairs[pc.pair];
@@ -556,17 +650,17 @@ void World::Impl::compute_forces(double hdt) {
       const int n = wall_contact_n[s];
       if (n == 0) continue;
       const int c = s_clump[s];
-      const TypeData& t = types[c_type[c]];
+      const TypeData& ty = types[c_type[c]];
       for (int k = 0; k < n; ++k) {
         WallContactData& wc = wall_contacts[s][k];
         const WallData& wd = walls[wc.wall];
-        const ResolvedContact& lw = law(t.material, wd.material);
+        const ResolvedContact& lw = law(ty.material, wd.material);
         const Eigen::Vector3d ri = wc.point - c_x[c];
         ContactKinematics kin;
         kin.normal = wc.normal;
         kin.overlap = wc.overlap;
         kin.r_star = s_r[s];
-        kin.m_star = t.mass;
+        kin.m_star = ty.mass;
         kin.radius_i = s_r[s];
         kin.radius_j = 0.0;
         if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) kin.arm_i = ri.norm();
@@ -583,59 +677,62 @@ void World::Impl::compute_forces(double hdt) {
       }
     }
 
-    // Sums (the loop above ends in a barrier, so every contact's force is in place).
-    const int nt = omp_get_num_threads(), t = omp_get_thread_num();
-    const int c0 = static_cast<int>(std::int64_t(nc) * t / nt);
-    const int c1 = static_cast<int>(std::int64_t(nc) * (t + 1) / nt);
-    for (int c = c0; c < c1; ++c) {
-      c_f[c].setZero();
-      c_t[c].setZero();
-      c_mroll[c] = 0.0;
-      if (implicit) c_damp[c].setZero();
-    }
-    auto mine = [&](int c) { return c >= c0 && c < c1; };
-    for (const PairContactData& pc : pair_contacts) {
-      const PairEntry& p = pairs[pc.pair];
-      const int ci = s_clump[p.i], cj = s_clump[p.j];
-      const bool own_i = mine(ci), own_j = mine(cj);
-      if (!own_i && !own_j) continue;
-      const bool rolling = law(types[c_type[ci]].material, types[c_type[cj]].material).rolling;
-      const bool damped = implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0);
-      if (own_i) {
-        c_f[ci] += pc.out.force;
-        c_t[ci] += pc.moment_i;
-        if (damped)
-          c_damp[ci] +=
-              2.0 * dashpot_load(pc.out, types[c_type[ci]], pc.point - c_x[ci], pc.normal);
+    // Sums (the loop above ends in a barrier, so every contact's force and the index are in
+    // place), then the implicit damping of each clump that needs it.
+#pragma omp for schedule(dynamic, 16)
+    for (int c = 0; c < nc; ++c) {
+      Eigen::Vector3d f = Eigen::Vector3d::Zero(), tq = Eigen::Vector3d::Zero();
+      double mroll = 0.0;
+      Eigen::Vector2d load = Eigen::Vector2d::Zero();
+      const TypeData& ty = types[c_type[c]];
+      for (int e = j_start[c]; e < j_start[c + 1]; ++e) {
+        const PairContactData& pc = pair_contacts[j_list[e]];
+        f -= pc.out.force;
+        tq -= pc.moment_j;
+        if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
+          load += 2.0 * dashpot_load(pc.out, ty, pc.point - c_x[c], pc.normal);
+        if (law(types[c_type[clump_i(j_list[e])]].material, ty.material).rolling)
+          tq += pc.out.torque_j, mroll += pc.out.roll_j;
       }
-      if (own_j) {
-        c_f[cj] -= pc.out.force;
-        c_t[cj] -= pc.moment_j;
-        if (damped)
-          c_damp[cj] +=
-              2.0 * dashpot_load(pc.out, types[c_type[cj]], pc.point - c_x[cj], pc.normal);
+      for (int k = i_start[c]; k < i_start[c + 1]; ++k) {
+        const PairContactData& pc = pair_contacts[k];
+        f += pc.out.force;
+        tq += pc.moment_i;
+        if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
+          load += 2.0 * dashpot_load(pc.out, ty, pc.point - c_x[c], pc.normal);
+        if (law(ty.material, types[c_type[clump_j(k)]].material).rolling)
+          tq += pc.out.torque_i, mroll += pc.out.roll_i;
       }
-      if (rolling) {
-        if (own_i) c_t[ci] += pc.out.torque_i, c_mroll[ci] += pc.out.roll_i;
-        if (own_j) c_t[cj] += pc.out.torque_j, c_mroll[cj] += pc.out.roll_j;
-      }
-    }
-    for (int s : wall_active) {
-      const int c = s_clump[s];
-      if (!mine(c)) continue;
-      for (int k = 0; k < wall_contact_n[s]; ++k) {
-        const WallContactData& wc = wall_contacts[s][k];
-        c_f[c] += wc.out.force;
-        c_t[c] += wc.moment;
-        if (law(types[c_type[c]].material, walls[wc.wall].material).rolling)
-          c_t[c] += wc.out.torque_i, c_mroll[c] += wc.out.roll_i;
-        if (implicit)
-          c_damp[c] += dashpot_load(wc.out, types[c_type[c]], wc.point - c_x[c], wc.normal);
+      const int s1 = c + 1 < nc ? c_first[c + 1] : static_cast<int>(s_r.size());
+      for (int sp = c_first[c]; sp < s1; ++sp)
+        for (int k = 0; k < wall_contact_n[sp]; ++k) {
+          const WallContactData& wc = wall_contacts[sp][k];
+          f += wc.out.force;
+          tq += wc.moment;
+          if (law(ty.material, walls[wc.wall].material).rolling)
+            tq += wc.out.torque_i, mroll += wc.out.roll_i;
+          if (implicit) load += dashpot_load(wc.out, ty, wc.point - c_x[c], wc.normal);
+        }
+      c_f[c] = f;
+      c_t[c] = tq;
+      c_mroll[c] = mroll;
+      if (implicit) {
+        c_damp[c] = load;
+        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;
       }
     }
-    if (implicit && hdt > 0.0) n_implicit += damp_implicitly(c0, c1, t);
-    if (t == 0) {
-      for (const PairContactData& pc : pair_contacts) elastic += pc.out.elastic_energy;
+    // The energies in fixed blocks of the contact list, added in block order: the same sum for
+    // any thread count.
+#pragma omp for schedule(static)
+    for (int b = 0; b < nblocks; ++b) {
+      double e = 0.0;
+      for (int k = b * kEnergyBlock; k < std::min(npc, (b + 1) * kEnergyBlock); ++k)
+        e += pair_contacts[k].out.elastic_energy;
+      block_energy[b] = e;
+    }
+#pragma omp single nowait
+    {
+      for (int b = 0; b < nblocks; ++b) elastic += block_energy[b];
       for (int s : wall_active)
         for (int k = 0; k < wall_contact_n[s]; ++k) {
           const WallContactData& wc = wall_contacts[s][k];
@@ -654,66 +751,55 @@ void World::Impl::compute_forces(double hdt) {
   }
 }
 
-// Implicit damping for the clumps [c0, c1) whose dashpot load is above the gate (their loads
-// are in c_damp, their summed force and torque in c_f, c_t): their own velocity enters their
-// damping implicitly (backward Euler), the neighbours' explicitly. The step then applies
-// F_eff = M (M + w dt C)^-1 F, with C the clump's damping matrix and F its whole force and
-// torque (gravity included, so a clump at rest stays at rest). Explicit damping overshoots above
-// a rate of about 1/step; this cannot (docs/dem.md). Returns the number of clumps treated.
-long World::Impl::damp_implicitly(int c0, int c1, int thread) {
-  // Per-thread scratch kept across steps (a fresh vector of 6×6 matrices every step was a
-  // large allocation per thread and step).
-  std::vector<std::pair<int, Matrix6d>>& hot = scratch_hot[thread];
-  std::vector<int>& slot = scratch_slot[thread];
-  hot.clear();
-  for (int c = c0; c < c1; ++c)
-    if (c_damp[c].x() * dt > settings.implicit_damping ||
-        c_damp[c].y() * dt > kTangentialGate * settings.implicit_damping) {
-      if (slot.size() < c_x.size()) slot.resize(c_x.size(), -1);
-      slot[c] = static_cast<int>(hot.size());
-      hot.push_back({c, Matrix6d::Zero()});
+// Implicit damping of clump c if its dashpot load is above the gate (its loads are in c_damp,
+// its summed force and torque in c_f, c_t): its own velocity enters its damping implicitly
+// (backward Euler), the neighbours' explicitly. The step then applies F_eff = M (M + w dt C)^-1 F,
+// with C the clump's damping matrix and F its whole force and torque (gravity included, so a clump
+// at rest stays at rest). Explicit damping overshoots above a rate of about 1/step; this cannot
+// (docs/dem.md). Returns whether the clump was treated.
+bool World::Impl::damp_implicitly(int c) {
+  if (!(c_damp[c].x() * dt > settings.implicit_damping ||
+        c_damp[c].y() * dt > kTangentialGate * settings.implicit_damping))
+    return false;
+  const int nc = static_cast<int>(c_x.size());
+  // C from the clump's contacts, in the order of the sums (compute_forces).
+  Matrix6d cm = Matrix6d::Zero();
+  for (int e = scratch_j_start[c]; e < scratch_j_start[c + 1]; ++e) {
+    const PairContactData& pc = pair_contacts[scratch_j_list[e]];
+    if (pc.out.dashpot_n != 0.0 || pc.out.dashpot_t != 0.0)
+      add_dashpots(cm, pc.point - c_x[c], pc.normal, pc.out.dashpot_n, pc.out.dashpot_t);
+  }
+  for (int k = scratch_i_start[c]; k < scratch_i_start[c + 1]; ++k) {
+    const PairContactData& pc = pair_contacts[k];
+    if (pc.out.dashpot_n != 0.0 || pc.out.dashpot_t != 0.0)
+      add_dashpots(cm, pc.point - c_x[c], pc.normal, pc.out.dashpot_n, pc.out.dashpot_t);
+  }
+  const int s1 = c + 1 < nc ? c_first[c + 1] : static_cast<int>(s_r.size());
+  for (int sp = c_first[c]; sp < s1; ++sp)
+    for (int w = 0; w < wall_contact_n[sp]; ++w) {
+      const WallContactData& wc = wall_contacts[sp][w];
+      add_dashpots(cm, wc.point - c_x[c], wc.normal, wc.out.dashpot_n, wc.out.dashpot_t);
     }
-  if (hot.empty()) return 0;
-  auto hot_slot = [&](int c) { return c >= c0 && c < c1 ? slot[c] : -1; };
-  for (const PairContactData& pc : pair_contacts) {
-    if (pc.out.dashpot_n == 0.0 && pc.out.dashpot_t == 0.0) continue;
-    const PairEntry& p = pairs[pc.pair];
-    for (const int c : {s_clump[p.i], s_clump[p.j]})
-      if (const int k = hot_slot(c); k >= 0)
-        add_dashpots(hot[k].second, pc.point - c_x[c], pc.normal, pc.out.dashpot_n,
-                     pc.out.dashpot_t);
-  }
-  for (int s : wall_active) {
-    const int c = s_clump[s], k = hot_slot(c);
-    if (k < 0) continue;
-    for (int w = 0; w < wall_contact_n[s]; ++w) {
-      const WallContactData& wc = wall_contacts[s][w];
-      add_dashpots(hot[k].second, wc.point - c_x[c], wc.normal, wc.out.dashpot_n, wc.out.dashpot_t);
-    }
-  }
-  for (auto& [c, cm] : hot) {
-    // (M + w dt C) y = F in world coordinates, M = diag(m, m, m, R I Rᵀ); F_eff = M y.
-    const TypeData& ty = types[c_type[c]];
-    const Eigen::Matrix3d inertia = c_R[c] * ty.inertia.asDiagonal() * c_R[c].transpose();
-    // The normal impulse is telescoped over two steps and the damping velocity is
-    // extrapolated: in a pure dashpot the scheme's fastest (alternating) mode responds to up to
-    // twice the coefficient, and the filter with C alone lets it grow once Γ dt is a few units.
-    // C is weighted w = 1 + σ/(1 + σ) (σ = the clump's load × dt ≥ Γ dt): about 1 for gentle
-    // contacts, 2 for stiff jams (a scalar model of both schemes is stable for every Γ dt with
-    // this weight: bench/damping_schemes.py).
-    const double sigma = c_damp[c].maxCoeff() * dt;
-    Matrix6d a = (dt * (1.0 + sigma / (1.0 + sigma))) * cm;
-    a.diagonal().head<3>().array() += ty.mass;
-    a.bottomRightCorner<3, 3>() += inertia;
-    Vector6d f;
-    f.head<3>() = c_f[c] + ty.mass * settings.gravity;
-    f.tail<3>() = c_t[c];
-    const Vector6d y = a.llt().solve(f);
-    c_f[c] = ty.mass * y.head<3>() - ty.mass * settings.gravity;
-    c_t[c] = inertia * y.tail<3>();
-    slot[c] = -1;
-  }
-  return static_cast<long>(hot.size());
+  // (M + w dt C) y = F in world coordinates, M = diag(m, m, m, R I Rᵀ); F_eff = M y.
+  const TypeData& ty = types[c_type[c]];
+  const Eigen::Matrix3d inertia = c_R[c] * ty.inertia.asDiagonal() * c_R[c].transpose();
+  // The normal impulse is telescoped over two steps and the damping velocity is
+  // extrapolated: in a pure dashpot the scheme's fastest (alternating) mode responds to up to
+  // twice the coefficient, and the filter with C alone lets it grow once Γ dt is a few units.
+  // C is weighted w = 1 + σ/(1 + σ) (σ = the clump's load × dt ≥ Γ dt): about 1 for gentle
+  // contacts, 2 for stiff jams (a scalar model of both schemes is stable for every Γ dt with
+  // this weight: bench/damping_schemes.py).
+  const double sigma = c_damp[c].maxCoeff() * dt;
+  Matrix6d a = (dt * (1.0 + sigma / (1.0 + sigma))) * cm;
+  a.diagonal().head<3>().array() += ty.mass;
+  a.bottomRightCorner<3, 3>() += inertia;
+  Vector6d f;
+  f.head<3>() = c_f[c] + ty.mass * settings.gravity;
+  f.tail<3>() = c_t[c];
+  const Vector6d y = solve_spd(a, f);
+  c_f[c] = ty.mass * y.head<3>() - ty.mass * settings.gravity;
+  c_t[c] = inertia * y.tail<3>();
+  return true;
 }
 
 void World::Impl::release_pinched(World& world) {

@@ -125,9 +125,6 @@ struct World::Impl {
   std::vector<Eigen::Vector3d> c_ww;            // world angular velocity (scratch)
   std::vector<Eigen::Vector3d> c_vp;            // predicted v(t) for damping (scratch)
   std::vector<Eigen::Vector2d> c_damp;  // implicit damping: normal, tangential dashpot load, 1/s
-  std::vector<std::vector<int>> scratch_slot;
-  std::vector<std::vector<std::pair<int, Eigen::Matrix<double, 6, 6>>>>
-      scratch_hot;  // per thread  // implicit damping: per thread, clump -> slot
 
   // Sub-spheres.
   std::vector<int> s_clump;
@@ -173,9 +170,16 @@ struct World::Impl {
   // Per-step scratch of detect_contacts (kept to avoid reallocation).
   std::vector<double> scratch_ratio;
   std::vector<std::vector<int>> scratch_near;                      // per sphere, rebuild_neighbours
+  std::vector<std::vector<std::array<int, 2>>> scratch_cand;       // per sphere, rebuild_neighbours
+  std::vector<std::pair<std::uint64_t, int>> scratch_bins;         // rebuild_neighbours
   std::vector<std::vector<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
   std::vector<std::pair<double, int>> scratch_max;  // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
+  // Per-step scratch of compute_forces: each clump's pair contacts (as sphere i: a range of
+  // the list; as sphere j: indices in list order), per-thread counts, energy partial sums.
+  std::vector<int> scratch_i_start, scratch_j_start, scratch_j_list;
+  std::vector<std::vector<int>> scratch_j_count;
+  std::vector<double> scratch_block_energy;
 
   std::vector<FactoryRuntime> factories;
 
@@ -201,7 +205,7 @@ struct World::Impl {
   void compute_forces(double history_dt);
   void kick();
   void check_health();
-  long damp_implicitly(int c0, int c1, int thread);  // step.cpp, in the forces' region
+  bool damp_implicitly(int c);  // step.cpp, in the forces' sums
   void release_pinched(World& world);
   void update_spheres(int first_clump);
 
