@@ -557,8 +557,9 @@ void World::Impl::compute_forces(double hdt) {
   std::vector<int>& i_start = scratch_i_start;
   std::vector<int>& j_start = scratch_j_start;
   std::vector<int>& j_list = scratch_j_list;
-  constexpr int kEnergyBlock = 1024;
-  const int nblocks = (npc + kEnergyBlock - 1) / kEnergyBlock;
+  // The pair laws go out in blocks of the list (dynamically: the cost per contact varies).
+  constexpr int kBlock = 256;
+  const int nblocks = (npc + kBlock - 1) / kBlock;
   std::vector<double>& block_energy = scratch_block_energy;
   block_energy.resize(nblocks);
   std::vector<std::vector<int>>& j_count = scratch_j_count;
@@ -614,34 +615,38 @@ void World::Impl::compute_forces(double hdt) {
     }
     for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;
 
-#pragma omp for schedule(dynamic, 256) nowait
-    for (int k = 0; k < npc; ++k) {
-      PairContactData& pc = pair_contacts[k];
-      const PairEntry& p = pairs[pc.pair];
-      const int ci = s_clump[p.i], cj = s_clump[p.j];
-      const TypeData& ti = types[c_type[ci]];
-      const TypeData& tj = types[c_type[cj]];
-      const ResolvedContact& lw = law(ti.material, tj.material);
-      const Eigen::Vector3d ri = pc.point - c_x[ci], rj = pc.point - c_x[cj];
-      ContactKinematics kin;
-      kin.normal = pc.normal;
-      kin.overlap = pc.overlap;
-      kin.r_star = s_r[p.i] * s_r[p.j] / (s_r[p.i] + s_r[p.j]);
-      kin.m_star = ti.mass * tj.mass / (ti.mass + tj.mass);
-      kin.radius_i = s_r[p.i];
-      kin.radius_j = s_r[p.j];
-      if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) {
-        kin.arm_i = ri.norm();
-        kin.arm_j = rj.norm();
+#pragma omp for schedule(dynamic, 1) nowait
+    for (int b = 0; b < nblocks; ++b) {
+      double block_elastic = 0.0;
+      for (int k = b * kBlock; k < std::min(npc, (b + 1) * kBlock); ++k) {
+        PairContactData& pc = pair_contacts[k];
+        const PairEntry& p = pairs[pc.pair];
+        const int ci = s_clump[p.i], cj = s_clump[p.j];
+        const TypeData& ti = types[c_type[ci]];
+        const TypeData& tj = types[c_type[cj]];
+        const ResolvedContact& lw = law(ti.material, tj.material);
+        const Eigen::Vector3d ri = pc.point - c_x[ci], rj = pc.point - c_x[cj];
+        ContactKinematics kin;
+        kin.normal = pc.normal;
+        kin.overlap = pc.overlap;
+        kin.r_star = s_r[p.i] * s_r[p.j] / (s_r[p.i] + s_r[p.j]);
+        kin.m_star = ti.mass * tj.mass / (ti.mass + tj.mass);
+        kin.radius_i = s_r[p.i];
+        kin.radius_j = s_r[p.j];
+        if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) {
+          kin.arm_i = ri.norm();
+          kin.arm_j = rj.norm();
+        }
+        kin.omega_i = c_ww[ci];
+        kin.omega_j = c_ww[cj];
+        const Eigen::Vector3d spin_i = c_ww[ci].cross(ri), spin_j = c_ww[cj].cross(rj);
+        kin.v_rel = (c_v[ci] + spin_i) - (c_v[cj] + spin_j);
+        kin.v_rel_damping = (c_vp[ci] + spin_i) - (c_vp[cj] + spin_j);
+        evaluate_contact(lw, kin, hdt, pair_hist[pc.pair], pc.out);
+        pc.rolling = lw.rolling;
+        block_elastic += pc.out.elastic_energy;
       }
-      kin.omega_i = c_ww[ci];
-      kin.omega_j = c_ww[cj];
-      const Eigen::Vector3d spin_i = c_ww[ci].cross(ri), spin_j = c_ww[cj].cross(rj);
-      kin.v_rel = (c_v[ci] + spin_i) - (c_v[cj] + spin_j);
-      kin.v_rel_damping = (c_vp[ci] + spin_i) - (c_vp[cj] + spin_j);
-      evaluate_contact(lw, kin, hdt, pair_hist[pc.pair], pc.out);
-      pc.moment_i = ri.cross(pc.out.force);
-      pc.moment_j = rj.cross(pc.out.force);
+      block_energy[b] = block_elastic;
     }
 
 #pragma omp for schedule(dynamic, 64)
@@ -687,21 +692,21 @@ void World::Impl::compute_forces(double hdt) {
       const TypeData& ty = types[c_type[c]];
       for (int e = j_start[c]; e < j_start[c + 1]; ++e) {
         const PairContactData& pc = pair_contacts[j_list[e]];
+        const Eigen::Vector3d r = pc.point - c_x[c];
         f -= pc.out.force;
-        tq -= pc.moment_j;
+        tq -= r.cross(pc.out.force);
         if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
-          load += 2.0 * dashpot_load(pc.out, ty, pc.point - c_x[c], pc.normal);
-        if (law(types[c_type[clump_i(j_list[e])]].material, ty.material).rolling)
-          tq += pc.out.torque_j, mroll += pc.out.roll_j;
+          load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
+        if (pc.rolling) tq += pc.out.torque_j, mroll += pc.out.roll_j;
       }
       for (int k = i_start[c]; k < i_start[c + 1]; ++k) {
         const PairContactData& pc = pair_contacts[k];
+        const Eigen::Vector3d r = pc.point - c_x[c];
         f += pc.out.force;
-        tq += pc.moment_i;
+        tq += r.cross(pc.out.force);
         if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
-          load += 2.0 * dashpot_load(pc.out, ty, pc.point - c_x[c], pc.normal);
-        if (law(ty.material, types[c_type[clump_j(k)]].material).rolling)
-          tq += pc.out.torque_i, mroll += pc.out.roll_i;
+          load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
+        if (pc.rolling) tq += pc.out.torque_i, mroll += pc.out.roll_i;
       }
       const int s1 = c + 1 < nc ? c_first[c + 1] : static_cast<int>(s_r.size());
       for (int sp = c_first[c]; sp < s1; ++sp)
@@ -721,15 +726,8 @@ void World::Impl::compute_forces(double hdt) {
         if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;
       }
     }
-    // The energies in fixed blocks of the contact list, added in block order: the same sum for
-    // any thread count.
-#pragma omp for schedule(static)
-    for (int b = 0; b < nblocks; ++b) {
-      double e = 0.0;
-      for (int k = b * kEnergyBlock; k < std::min(npc, (b + 1) * kEnergyBlock); ++k)
-        e += pair_contacts[k].out.elastic_energy;
-      block_energy[b] = e;
-    }
+    // The contacts' energies, summed per block by the law loop, added in block order: the same
+    // sum for any thread count.
 #pragma omp single nowait
     {
       for (int b = 0; b < nblocks; ++b) elastic += block_energy[b];

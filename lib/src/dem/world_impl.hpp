@@ -57,9 +57,8 @@ struct PairContactData {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double overlap = 0.0;
   bool closing = false;  // overlap gone, last damping impulse only (contact_law.hpp)
+  bool rolling = false;  // the pair's law has rolling resistance (forces stage)
   ContactForce out;
-  // (point − centre) × force for clumps i and j (forces stage).
-  Eigen::Vector3d moment_i = Eigen::Vector3d::Zero(), moment_j = Eigen::Vector3d::Zero();
 };
 
 inline constexpr int kWallSlots = 4;  // wall contacts kept per sphere
