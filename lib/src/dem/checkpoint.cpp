@@ -177,6 +177,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   in.vec(w.s_pos_build);
   in.vec(w.pairs);
   in.vec(w.pair_hist);
+  w.pair_live.clear();  // rebuilt from the histories at the next detection
   in.vec(w.wall_cand_start);
   in.vec(w.wall_cand);
   in.vec(w.wall_slots);

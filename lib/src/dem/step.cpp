@@ -267,6 +267,10 @@ void World::Impl::detect_contacts() {
   // re-constructed: zeroing ~200 bytes per contact every step cost more than the scan.
   const int np = static_cast<int>(pairs.size());
   const int nt = np >= kParallelMin ? std::max(threads, 1) : 1;
+  if (pair_live.size() != pairs.size()) {
+    pair_live.resize(np);
+    for (int k = 0; k < np; ++k) pair_live[k] = history_empty(pair_hist[k]) ? 0 : 1;
+  }
   scratch_touch.resize(nt);
   scratch_max.assign(nt, {0.0, -1});
   std::vector<size_t> offset(nt + 1, 0);
@@ -281,18 +285,23 @@ void World::Impl::detect_contacts() {
       const PairEntry& p = pairs[k];
       const double rr = s_r[p.i] + s_r[p.j];
       const double d2 = (s_pos[p.i] - s_pos[p.j]).squaredNorm();
-      ContactHistory& h = pair_hist[k];
       if (d2 < rr * rr) {
         touch.push_back({k, std::sqrt(d2)});
-      } else if (h.damping != 0.0) {
-        // Closing: the overlap ended during the step, one damping impulse is left (a
-        // negative distance marks it).
-        h.shear.setZero();
-        h.roll.setZero();
-        touch.push_back({k, -std::sqrt(d2)});
-      } else if (!h.shear.isZero(0.0) || !h.roll.isZero(0.0)) {
-        // Most listed pairs are apart with an empty history: read, do not rewrite.
-        h = ContactHistory{};
+        pair_live[k] = 1;
+      } else if (pair_live[k]) {
+        // Most listed pairs are apart with an empty history, known from the flag alone (their
+        // histories are not read: at paper scale that was a stream of ~2 MB per step).
+        ContactHistory& h = pair_hist[k];
+        if (h.damping != 0.0) {
+          // Closing: the overlap ended during the step, one damping impulse is left (a
+          // negative distance marks it).
+          h.shear.setZero();
+          h.roll.setZero();
+          touch.push_back({k, -std::sqrt(d2)});
+        } else {
+          if (!h.shear.isZero(0.0) || !h.roll.isZero(0.0)) h = ContactHistory{};
+          pair_live[k] = 0;
+        }
       }
     }
     offset[t + 1] = touch.size();

@@ -547,6 +547,7 @@ int World::remove_clumps(const std::function<bool(int)>& remove) {
   }
   w.pairs.resize(o);
   w.pair_hist.resize(o);
+  w.pair_live.clear();  // rebuilt from the histories at the next detection
   // Contacts of the last evaluation are dropped; wall candidates are rebuilt next step.
   w.pair_contacts.clear();
   w.wall_contacts.assign(ks, {});

@@ -137,6 +137,10 @@ struct World::Impl {
   // candidates (wall, triangle) in CSR form; per-sphere wall contact histories.
   std::vector<PairEntry> pairs;
   std::vector<ContactHistory> pair_hist;
+  // Per listed pair: 1 if its history may be non-empty (it touched or was closing at the last
+  // detection), so detect_contacts reads the history of an apart pair only then. Rebuilt from
+  // the histories when its size differs from the list's (after a checkpoint load or removals).
+  std::vector<std::uint8_t> pair_live;
   std::vector<int> wall_cand_start;
   std::vector<std::array<int, 2>> wall_cand;
   // Per wall, its triangles binned by cell in the wall's own frame (its vertices at t = 0): a
@@ -220,6 +224,11 @@ struct World::Impl {
   void refresh_wall_active();
   std::uint64_t compute_fingerprint() const;
 };
+
+/// Whether a contact history holds anything (springs or a pending damping impulse).
+inline bool history_empty(const ContactHistory& h) {
+  return h.damping == 0.0 && h.shear.isZero(0.0) && h.roll.isZero(0.0);
+}
 
 /// FNV-1a over raw bytes.
 struct Hasher {
