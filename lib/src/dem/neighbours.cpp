@@ -133,8 +133,7 @@ void World::Impl::rebuild_neighbours() {
   }
   pairs.swap(next);
   pair_hist.swap(next_hist);
-  pair_live.resize(pairs.size());
-  for (size_t k = 0; k < pairs.size(); ++k) pair_live[k] = history_empty(pair_hist[k]) ? 0 : 1;
+  pair_live.clear();  // rebuilt from the carried histories at the next detection
 
   // Wall triangles binned into the cells their (grown) bounding boxes touch, in each wall's
   // frame at t = 0 (once: a wall moves rigidly). The bins only pre-select; the exact test below

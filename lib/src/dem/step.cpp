@@ -201,8 +201,7 @@ void World::Impl::kick_and_drift() {
       c_wb[c] = pi.cwiseProduct(t.inv_inertia);
       // The clump's spheres (contiguous) follow while its pose is at hand.
       const Eigen::Vector3d& x = c_x[c];
-      const int s1 = c + 1 < nc ? c_first[c + 1] : ns;
-      for (int s = c_first[c]; s < s1; ++s) {
+      for (int s = c_first[c]; s < sphere_end(c); ++s) {
         s_pos[s] = x + R * s_off[s];
         ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
       }
@@ -478,6 +477,15 @@ void World::Impl::detect_contacts() {
   }
 }
 
+template <class Pair, class Wall>
+void World::Impl::visit_contacts(int c, Pair&& pair, Wall&& wall) const {
+  for (int e = scratch_j_start[c]; e < scratch_j_start[c + 1]; ++e)
+    pair(pair_contacts[scratch_j_list[e]], false);
+  for (int k = scratch_i_start[c]; k < scratch_i_start[c + 1]; ++k) pair(pair_contacts[k], true);
+  for (int s = c_first[c]; s < sphere_end(c); ++s)
+    for (int k = 0; k < wall_contact_n[s]; ++k) wall(wall_contacts[s][k]);
+}
+
 void World::Impl::compute_forces(double hdt) {
   const int nc = static_cast<int>(c_x.size());
   const int npc = static_cast<int>(pair_contacts.size());
@@ -635,34 +643,28 @@ void World::Impl::compute_forces(double hdt) {
       double mroll = 0.0;
       Eigen::Vector2d load = Eigen::Vector2d::Zero();
       const TypeData& ty = types[c_type[c]];
-      for (int e = j_start[c]; e < j_start[c + 1]; ++e) {
-        const PairContactData& pc = pair_contacts[j_list[e]];
-        const Eigen::Vector3d r = pc.point - c_x[c];
-        f -= pc.out.force;
-        tq -= r.cross(pc.out.force);
-        if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
-          load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
-        if (pc.rolling) tq += pc.out.torque_j, mroll += pc.out.roll_j;
-      }
-      for (int k = i_start[c]; k < i_start[c + 1]; ++k) {
-        const PairContactData& pc = pair_contacts[k];
-        const Eigen::Vector3d r = pc.point - c_x[c];
-        f += pc.out.force;
-        tq += r.cross(pc.out.force);
-        if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
-          load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
-        if (pc.rolling) tq += pc.out.torque_i, mroll += pc.out.roll_i;
-      }
-      const int s1 = c + 1 < nc ? c_first[c + 1] : static_cast<int>(s_r.size());
-      for (int sp = c_first[c]; sp < s1; ++sp)
-        for (int k = 0; k < wall_contact_n[sp]; ++k) {
-          const WallContactData& wc = wall_contacts[sp][k];
-          f += wc.out.force;
-          tq += wc.moment;
-          if (law(ty.material, walls[wc.wall].material).rolling)
-            tq += wc.out.torque_i, mroll += wc.out.roll_i;
-          if (implicit) load += dashpot_load(wc.out, ty, wc.point - c_x[c], wc.normal);
-        }
+      visit_contacts(
+          c,
+          [&](const PairContactData& pc, bool as_i) {
+            // The force on sphere j is −force; each side has its own rolling torque.
+            const Eigen::Vector3d r = pc.point - c_x[c];
+            const Eigen::Vector3d fc = as_i ? pc.out.force : Eigen::Vector3d(-pc.out.force);
+            f += fc;
+            tq += r.cross(fc);
+            if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
+              load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
+            if (pc.rolling) {
+              tq += as_i ? pc.out.torque_i : pc.out.torque_j;
+              mroll += as_i ? pc.out.roll_i : pc.out.roll_j;
+            }
+          },
+          [&](const WallContactData& wc) {
+            f += wc.out.force;
+            tq += wc.moment;
+            if (law(ty.material, walls[wc.wall].material).rolling)
+              tq += wc.out.torque_i, mroll += wc.out.roll_i;
+            if (implicit) load += dashpot_load(wc.out, ty, wc.point - c_x[c], wc.normal);
+          });
       c_f[c] = f;
       c_t[c] = tq;
       c_mroll[c] = mroll;
@@ -704,25 +706,17 @@ bool World::Impl::damp_implicitly(int c) {
   if (!(c_damp[c].x() * dt > settings.implicit_damping ||
         c_damp[c].y() * dt > kTangentialGate * settings.implicit_damping))
     return false;
-  const int nc = static_cast<int>(c_x.size());
   // C from the clump's contacts, in the order of the sums (compute_forces).
   Matrix6d cm = Matrix6d::Zero();
-  for (int e = scratch_j_start[c]; e < scratch_j_start[c + 1]; ++e) {
-    const PairContactData& pc = pair_contacts[scratch_j_list[e]];
-    if (pc.out.dashpot_n != 0.0 || pc.out.dashpot_t != 0.0)
-      add_dashpots(cm, pc.point - c_x[c], pc.normal, pc.out.dashpot_n, pc.out.dashpot_t);
-  }
-  for (int k = scratch_i_start[c]; k < scratch_i_start[c + 1]; ++k) {
-    const PairContactData& pc = pair_contacts[k];
-    if (pc.out.dashpot_n != 0.0 || pc.out.dashpot_t != 0.0)
-      add_dashpots(cm, pc.point - c_x[c], pc.normal, pc.out.dashpot_n, pc.out.dashpot_t);
-  }
-  const int s1 = c + 1 < nc ? c_first[c + 1] : static_cast<int>(s_r.size());
-  for (int sp = c_first[c]; sp < s1; ++sp)
-    for (int w = 0; w < wall_contact_n[sp]; ++w) {
-      const WallContactData& wc = wall_contacts[sp][w];
-      add_dashpots(cm, wc.point - c_x[c], wc.normal, wc.out.dashpot_n, wc.out.dashpot_t);
-    }
+  visit_contacts(
+      c,
+      [&](const PairContactData& pc, bool) {
+        if (pc.out.dashpot_n != 0.0 || pc.out.dashpot_t != 0.0)
+          add_dashpots(cm, pc.point - c_x[c], pc.normal, pc.out.dashpot_n, pc.out.dashpot_t);
+      },
+      [&](const WallContactData& wc) {
+        add_dashpots(cm, wc.point - c_x[c], wc.normal, wc.out.dashpot_n, wc.out.dashpot_t);
+      });
   // (M + w dt C) y = F in world coordinates, M = diag(m, m, m, R I Rᵀ); F_eff = M y.
   const TypeData& ty = types[c_type[c]];
   const Eigen::Matrix3d inertia = c_R[c] * ty.inertia.asDiagonal() * c_R[c].transpose();

@@ -787,8 +787,7 @@ std::uint64_t World::state_hash() const {
   h.vec(w.c_t);
   h.vec(w.c_mroll);
   for (size_t k = 0; k < w.pairs.size(); ++k)
-    if (!w.pair_hist[k].shear.isZero(0.0) || !w.pair_hist[k].roll.isZero(0.0) ||
-        w.pair_hist[k].damping != 0.0) {
+    if (!history_empty(w.pair_hist[k])) {
       h.value(w.pairs[k]);
       h.value(w.pair_hist[k]);
     }

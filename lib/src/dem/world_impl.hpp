@@ -139,7 +139,8 @@ struct World::Impl {
   std::vector<ContactHistory> pair_hist;
   // Per listed pair: 1 if its history may be non-empty (it touched or was closing at the last
   // detection), so detect_contacts reads the history of an apart pair only then. Rebuilt from
-  // the histories when its size differs from the list's (after a checkpoint load or removals).
+  // the histories by detect_contacts when its size differs from the list's (cleared by a
+  // rebuild, a checkpoint load and removals).
   std::vector<std::uint8_t> pair_live;
   std::vector<int> wall_cand_start;
   std::vector<std::array<int, 2>> wall_cand;
@@ -213,6 +214,15 @@ struct World::Impl {
   void update_spheres(int first_clump);
 
   // Helpers.
+  /// One past clump c's last sphere (its spheres are s in [c_first[c], sphere_end(c))).
+  int sphere_end(int c) const {
+    return c + 1 < static_cast<int>(c_first.size()) ? c_first[c + 1] : static_cast<int>(s_r.size());
+  }
+  /// Visits clump c's contacts of the last detection in the order of its force sum: its pair
+  /// contacts as sphere j, then as sphere i (each in list order; the index compute_forces
+  /// builds), then its spheres' wall contacts. pair(pc, as_i), wall(wc). step.cpp.
+  template <class Pair, class Wall>
+  void visit_contacts(int c, Pair&& pair, Wall&& wall) const;
   const ResolvedContact& law(int ma, int mb) const {
     return laws[static_cast<size_t>(ma) * materials.size() + mb];
   }
