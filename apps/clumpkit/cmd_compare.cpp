@@ -231,18 +231,19 @@ Command setup_diagnose(CLI::App& parent) {
               o.progress = [](const std::string& s) { std::cerr << "diagnose: " << s << "\n"; };
             RigSimulator sim = make_sim(*a);
             const Diagnosis d = diagnose(base, ms, sim, o);
-            std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9} {:>9} {:>9} {:>7} {}\n",
-                                     "effect", "parameter", "fitted", "+/-", "chi2", "dchi2", "BIC",
-                                     "weight", "plausible");
+            std::cout << fmt::format(
+                "{:<18} {:<38} {:>14} {:>10} {:>9} {:>9} {:>9} {:>7} {:<13} {}\n", "effect",
+                "parameter", "fitted", "+/-", "chi2", "dchi2", "BIC", "weight", "plausible",
+                "chi2 from");
             std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9.2f} {:>9} {:>9.2f}\n",
                                      "(baseline)", base.name, "", "", d.baseline.chi2, "",
                                      d.baseline_bic);
             for (const auto& r : d.candidates)
               std::cout << fmt::format(
-                  "{:<18} {:<38} {:>14} {:>10.3g} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {}\n",
+                  "{:<18} {:<38} {:>14} {:>10.3g} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {:<13} {}\n",
                   r.candidate.effect, r.candidate.parameter, r.candidate.format(r.fitted),
                   r.fitted_std, r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
-                  r.plausible ? "yes" : "no (at bound)");
+                  r.plausible ? "yes" : "no (at bound)", chi2_source_text(r));
             for (const auto& s : d.skipped) std::cout << "not tried: " << s << "\n";
             std::cout << d.summary();
             std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n",
@@ -260,7 +261,9 @@ Command setup_diagnose(CLI::App& parent) {
                                {"bic", r.bic},
                                {"weight", r.weight},
                                {"plausible", r.plausible},
-                               {"at_bound", r.at_bound}});
+                               {"at_bound", r.at_bound},
+                               {"chi2_source", r.chi2_source},
+                               {"chi2_at", r.chi2_at}});
             json sugg = json::array();
             for (const auto& s : d.suggestions)
               sugg.push_back({{"rig", s.rig},

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
+#include <set>
 
 #include "clumpkit/core/error.hpp"
 #include "fake_simulator.hpp"
@@ -197,4 +199,70 @@ TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {
   EXPECT_NEAR(chi2_survival(18.307, 10), 0.05, 1e-4);
   EXPECT_NEAR(chi2_survival(10.0, 10), 0.4405, 1e-4);
   EXPECT_NEAR(chi2_survival(0.0, 3), 1.0, 1e-12);
+}
+
+// Candidates the surrogate puts far behind the best real run are not simulated again at their
+// fitted value: the verdict and the leader's fit are those of a diagnosis that confirms every
+// candidate, every unconfirmed one is at least the margin behind, and fewer runs are made.
+TEST(Diagnosis, SkippingHopelessConfirmationsChangesNoVerdict) {
+  int skipped_total = 0;
+  for (const Hidden& h : {Hidden{"rolling_friction", "effects.rolling_friction", "0.12", 0.12},
+                          Hidden{"cohesion", "effects.cohesion", "9000 J/m^3", 9000.0}}) {
+    ParticleModel base = base_model();
+    set_model_effect(base, h.key, "off", "test");
+    ParticleModel truth = base;
+    set_model_effect(truth, h.key, h.value, "test");
+    fake::FakeSimulator lab;
+    const auto ms = synthesize(lab, truth, 0.02, 515);
+    DiagnoseOptions o;
+    o.suggest = false;
+    fake::FakeSimulator sim_a, sim_b;
+    const Diagnosis a = diagnose(base, ms, sim_a, o);
+    o.confirm_margin = std::numeric_limits<double>::infinity();
+    const Diagnosis b = diagnose(base, ms, sim_b, o);
+    EXPECT_EQ(a.verdict, h.effect) << a.summary();
+    EXPECT_EQ(b.verdict, a.verdict);
+    ASSERT_FALSE(a.candidates.empty());
+    EXPECT_EQ(a.candidates.front().fitted, b.candidates.front().fitted);
+    EXPECT_NE(a.candidates.front().chi2_source, "surrogate");
+    int skipped = 0;
+    for (const auto& c : a.candidates) {
+      if (c.chi2_source != "surrogate") continue;
+      ++skipped;
+      // The margin is on the fit's chi2; the comparison's differs by the variances only.
+      EXPECT_GE(c.comparison.chi2, a.candidates.front().comparison.chi2 + 0.5 * 25.0)
+          << c.candidate.effect;
+      EXPECT_LT(c.weight, 1e-4);
+    }
+    for (const auto& c : b.candidates) EXPECT_NE(c.chi2_source, "surrogate");
+    EXPECT_EQ(sim_b.runs() - sim_a.runs(), skipped * static_cast<long>(ms.size()));
+    skipped_total += skipped;
+  }
+  EXPECT_GT(skipped_total, 0) << "the test needs a hopeless candidate to mean anything";
+}
+
+// The next measurement is a setting of the experiment (a cup or plate material, a wheel speed),
+// never one of the simulation (scale, stiffness, implicit damping).
+TEST(Diagnosis, SuggestsOnlyExperimentalSettings) {
+  ParticleModel base = base_model();
+  set_model_effect(base, "effects.rolling_friction", "off", "test");
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
+  fake::FakeSimulator sim;
+  auto ms = synthesize(sim, truth, 0.02, 99);
+  ms.resize(3);  // the three cups only: the plates and the wheel speeds are left to suggest
+  DiagnoseOptions o;
+  o.effects = {"rolling_friction", "cohesion"};
+  o.suggest_max = 100;
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  ASSERT_FALSE(d.suggestions.empty());
+  std::set<std::string> settings;
+  for (const auto& s : d.suggestions) {
+    settings.insert(s.rig + " " + s.setting);
+    EXPECT_EQ(s.setting.find("implicit_damping"), std::string::npos) << s.setting;
+    EXPECT_EQ(s.setting.find("stiffness"), std::string::npos) << s.setting;
+    EXPECT_EQ(s.setting.find("scale"), std::string::npos) << s.setting;
+  }
+  EXPECT_TRUE(settings.count("angle_of_repose plate=abs_plastic")) << d.summary();
+  EXPECT_TRUE(settings.count("discharge rpm=15")) << d.summary();
 }

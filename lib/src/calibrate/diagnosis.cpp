@@ -209,6 +209,11 @@ std::string observable_name(const Measurement& m) {
 
 }  // namespace
 
+std::string chi2_source_text(const CandidateResult& r) {
+  if (r.chi2_source == "nearest_run") return "run at " + r.candidate.format(r.chi2_at);
+  return r.chi2_source;
+}
+
 double chi2_survival(double x, int dof) {
   return gamma_q(0.5 * dof, 0.5 * x);
 }
@@ -268,10 +273,12 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     Values at_fit;
     bool have_at_fit = false;
     bool dropped = false;  ///< a run at its fitted value failed (reason in d.skipped)
+    std::string source = "run";
+    double at = 0.0;  ///< parameter value of at_fit
   };
   std::vector<Work> work;
   for (const auto& c : cands) {
-    Work w{c, {}, {}, {}, false, false};
+    Work w{c, {}, {}, {}, false, false, "run", 0.0};
     // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
     // the candidate out with the reason; it does not end the diagnosis.
     try {
@@ -285,6 +292,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
             best = chi2;
             w.fit = {c.levels[i], chi2, 0.0};
             w.at_fit = v;
+            w.at = c.levels[i];
             w.have_at_fit = true;
           }
         }
@@ -337,40 +345,71 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     }
     refining = still;
   }
-  {  // the confirmation runs below, side by side
-    std::vector<ParticleModel> models;
-    for (const Work& w : work) {
-      if (w.have_at_fit || w.dropped) continue;
-      bool found = false;
-      for (const auto& [t, v] : w.s.points) found = found || t == w.fit.theta;
-      if (!found) models.push_back(w.c.apply(base, w.fit.theta));
+  // How each continuous candidate's chi2 at its fitted value is known. A simulated point within
+  // a quarter of the fitted uncertainty serves (the refinement's own convergence test); a
+  // candidate the surrogate puts far behind the best real run is not simulated again (at
+  // mini scale each confirmation is 4-8 rig runs, and such candidates are usually pinned at a
+  // bound of their range); every other candidate gets a confirmation run at its fitted value.
+  double best_real = compare(ms, pool.pooled(s0), 0).chi2;
+  for (const Work& w : work) {
+    if (w.dropped) continue;
+    if (w.have_at_fit) best_real = std::min(best_real, compare(ms, pool.pooled(w.at_fit), 1).chi2);
+    for (const auto& [t, v] : w.s.points)
+      best_real = std::min(best_real, compare(ms, pool.pooled(v), 1).chi2);
+  }
+  std::vector<Work*> confirm;
+  for (Work& w : work) {
+    if (w.have_at_fit || w.dropped) continue;
+    const std::pair<double, Values>* nearest = nullptr;
+    for (const auto& p : w.s.points)
+      if (std::abs(p.first - w.fit.theta) <= 0.25 * w.fit.sigma &&
+          (!nearest || std::abs(p.first - w.fit.theta) < std::abs(nearest->first - w.fit.theta)))
+        nearest = &p;
+    if (nearest) {
+      w.at_fit = nearest->second;
+      w.at = nearest->first;
+      w.source = nearest->first == w.fit.theta ? "run" : "nearest_run";
+      w.have_at_fit = true;
+    } else if (w.fit.chi2 >= best_real + o.confirm_margin) {
+      // The surrogate's prediction, each value with the variance the fit gave it.
+      const Values pooled0 = pool.pooled(s0);
+      for (const auto& m : ms) {
+        const SimulatedValue& b = pooled0.at(m.key());
+        SimulatedValue v;
+        v.n = b.n;
+        v.mean = w.s.value(m.key(), w.fit.theta);
+        v.std = b.n > 0 ? std::sqrt(w.s.noise_var(m.key(), b.std * b.std / b.n) * b.n) : b.std;
+        w.at_fit[m.key()] = v;
+      }
+      w.at = w.fit.theta;
+      w.source = "surrogate";
+      w.have_at_fit = true;
+      say(
+          fmt::format("{}: not confirmed: its surrogate chi2 at {} is {:.1f}, {:.1f} above the "
+                      "best run",
+                      w.c.effect, w.c.format(w.fit.theta), w.fit.chi2, w.fit.chi2 - best_real));
+    } else {
+      confirm.push_back(&w);
     }
+  }
+  {  // the confirmation runs, side by side
+    std::vector<ParticleModel> models;
+    for (const Work* w : confirm) models.push_back(w->c.apply(base, w->fit.theta));
     prefetch(models);
   }
-  // Every candidate's reported chi2 comes from a real simulation at its fitted value.
-  for (Work& w : work) {
-    if (w.dropped) continue;
-    if (!w.have_at_fit) {
-      bool found = false;
-      for (const auto& [t, v] : w.s.points)
-        if (t == w.fit.theta) {
-          w.at_fit = v;
-          found = true;
-        }
-      if (!found) {
-        say(fmt::format("{}: confirming at {}", w.c.effect, w.c.format(w.fit.theta)));
-        try {
-          w.at_fit = simulate(w.c.apply(base, w.fit.theta));
-        } catch (const NumericalError& e) {
-          d.skipped.push_back(w.c.effect + ": the run at its fitted value " +
-                              w.c.format(w.fit.theta) + " failed: " + e.what());
-          w.dropped = true;
-          continue;
-        }
-        w.s.add(w.fit.theta, w.at_fit);
-      }
-      w.have_at_fit = true;
+  for (Work* w : confirm) {
+    say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(w->fit.theta)));
+    try {
+      w->at_fit = simulate(w->c.apply(base, w->fit.theta));
+    } catch (const NumericalError& e) {
+      d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
+                          w->c.format(w->fit.theta) + " failed: " + e.what());
+      w->dropped = true;
+      continue;
     }
+    w->s.add(w->fit.theta, w->at_fit);
+    w->at = w->fit.theta;
+    w->have_at_fit = true;
   }
   // All runs are made: every comparison weighs by the final pooled spread.
   d.baseline = compare(ms, pool.pooled(s0), 0);
@@ -382,7 +421,10 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     r.candidate = w.c;
     r.fitted = w.fit.theta;
     r.fitted_std = w.fit.sigma;
-    r.comparison = compare(ms, pool.pooled(w.at_fit), 1);
+    // A surrogate's values keep the spread the fit gave them; a run's are pooled.
+    r.comparison = compare(ms, w.source == "surrogate" ? w.at_fit : pool.pooled(w.at_fit), 1);
+    r.chi2_source = w.source;
+    r.chi2_at = w.at;
     r.delta_chi2 = d.baseline.chi2 - r.comparison.chi2;
     r.bic = r.comparison.chi2 + ln_n;
     const double span = w.c.hi - w.c.lo;
@@ -449,7 +491,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       for (const auto& st : rig.settings) {
         std::vector<std::string> values = st.choices;
         if (st.key == "rpm") values = {"10", "15", "30"};
-        if (st.key == "scale" || values.empty()) continue;
+        if (!st.experimental || values.empty()) continue;
         for (const auto& v : values) {
           SimRequest r{rig.name, sample, parse_settings(rig, st.key + "=" + v, "suggest")};
           r.settings["scale"] = o.scale;

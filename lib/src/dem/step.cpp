@@ -159,13 +159,14 @@ void World::Impl::kick_and_drift() {
   const int nc = static_cast<int>(c_x.size());
   const int ns = static_cast<int>(s_r.size());
   const double h = 0.5 * dt;
-  double ds = 0.0;
+  TopTwo top;
   // One loop over the clumps, each moving its own spheres (fewer fork-joins per step, no
-  // gather of clump poses per sphere); the spheres' largest displacement since the last
-  // neighbour rebuild comes along for free.
+  // gather of clump poses per sphere); the clumps' largest displacements since the last
+  // neighbour rebuild come along for free.
 #pragma omp parallel num_threads(threads) if (ns >= kParallelMin)
   {
-#pragma omp for schedule(static) reduction(max : ds)
+    TopTwo mine;
+#pragma omp for schedule(static) nowait
     for (int c = 0; c < nc; ++c) {
       half_kick(*this, c, h);
       c_x[c] += dt * c_v[c];
@@ -201,13 +202,21 @@ void World::Impl::kick_and_drift() {
       c_wb[c] = pi.cwiseProduct(t.inv_inertia);
       // The clump's spheres (contiguous) follow while its pose is at hand.
       const Eigen::Vector3d& x = c_x[c];
+      double dc = 0.0;
       for (int s = c_first[c]; s < sphere_end(c); ++s) {
         s_pos[s] = x + R * s_off[s];
-        ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+        dc = std::max(dc, (s_pos[s] - s_pos_build[s]).squaredNorm());
       }
+      mine.add(dc);
+    }
+    // The two largest of a set do not depend on the order it is merged in.
+#pragma omp critical(clumpkit_drift_top_two)
+    {
+      top.add(mine.first);
+      top.add(mine.second);
     }
   }
-  drift_disp2 = ds;
+  drift_disp2 = top;
   drift_disp_valid = true;
 }
 
@@ -238,21 +247,29 @@ void World::Impl::move_walls() {
 }
 
 void World::Impl::update_neighbours() {
-  const int ns = static_cast<int>(s_r.size());
-  double ds = 0.0;
+  TopTwo top;
   if (drift_disp_valid) {
-    ds = drift_disp2;  // measured by kick_and_drift; spheres added since have not moved
+    top = drift_disp2;  // measured by kick_and_drift; spheres added since have not moved
   } else {
-    for (int s = 0; s < ns; ++s) ds = std::max(ds, (s_pos[s] - s_pos_build[s]).squaredNorm());
+    const int nc = static_cast<int>(c_first.size());
+    for (int c = 0; c < nc; ++c) {
+      double dc = 0.0;
+      for (int s = c_first[c]; s < sphere_end(c); ++s)
+        dc = std::max(dc, (s_pos[s] - s_pos_build[s]).squaredNorm());
+      top.add(dc);
+    }
   }
   drift_disp_valid = false;
-  ds = std::sqrt(ds);
+  // A listed pair (spheres of two clumps) stays complete while the two spheres' displacements
+  // sum to less than the skin; the worst pair is the two clumps that moved most. (Twice the
+  // largest displacement, the usual bound, rebuilt the whole list for one fast pill.)
+  const double d1 = std::sqrt(top.first), d2 = std::sqrt(top.second);
   double dw = 0.0;
   for (const WallData& wd : walls)
     for (size_t k = 0; k < wd.vertices.size(); ++k)
       dw = std::max(dw, (wd.vertices[k] - wd.vertices_build[k]).squaredNorm());
   dw = std::sqrt(dw);
-  if (need_rebuild || 2.0 * ds > skin || ds + dw > skin) {
+  if (need_rebuild || d1 + d2 > skin || d1 + dw > skin) {
     rebuild_neighbours();
     ++profile.neighbour_rebuilds;
   }

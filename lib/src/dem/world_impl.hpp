@@ -156,9 +156,21 @@ struct World::Impl {
   std::vector<int> wall_active;
   bool wall_active_dirty = true;
   bool need_rebuild = true;
-  // Largest squared sphere displacement since the rebuild, measured by kick_and_drift for the
+  // The two largest squared sphere displacements since the rebuild that belong to different
+  // clumps (a clump's own spheres are never paired), measured by kick_and_drift for the
   // update_neighbours that follows it (m^2).
-  double drift_disp2 = 0.0;
+  struct TopTwo {
+    double first = 0.0, second = 0.0;
+    void add(double x) {
+      if (x > first) {
+        second = first;
+        first = x;
+      } else if (x > second) {
+        second = x;
+      }
+    }
+  };
+  TopTwo drift_disp2;
   bool drift_disp_valid = false;
   double skin = 0.0, cell = 0.0, r_max = 0.0, r_min = 0.0;
 

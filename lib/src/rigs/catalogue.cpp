@@ -28,18 +28,21 @@ const std::vector<RigInfo>& rig_catalogue() {
                             "",
                             "mini",
                             "rig size: tiny (smoke tests, ~100-200 pills), mini (quick), small, "
-                            "paper (the paper's sizes)"};
+                            "paper (the paper's sizes)",
+                            false};
     const std::vector<std::string> walls = {"abs_plastic", "organic_glass", "galvanized_steel"};
     // A speed-up, not physics: every Young's modulus times this factor (the scale sets it).
     const SettingInfo stiffness{
-        "stiffness", {}, "1", "1", "factor on every Young's modulus (scale default; 1 = Table 1)"};
+        "stiffness", {}, "1", "1", "factor on every Young's modulus (scale default; 1 = Table 1)",
+        false};
     // The engine's implicit-damping gate (WorldSettings::implicit_damping); 0 = off, the time
     // step then cut to the stiffest contact mode's damping rate as before session 10.
     const SettingInfo damping{"implicit_damping",
                               {"on", "off"},
                               "",
                               "on",
-                              "jammed pills damped implicitly (off: explicit, a smaller step)"};
+                              "jammed pills damped implicitly (off: explicit, a smaller step)",
+                              false};
     std::vector<RigInfo> r;
     r.push_back(
         {"bulk_density",

@@ -30,6 +30,10 @@ struct DiagnoseOptions {
   int refine_top = 3;                ///< how many leading candidates are refined
   double min_delta_bic = 6.0;        ///< "strong" evidence (Kass & Raftery)
   double p_inconsistent = 0.01;
+  /// A continuous candidate whose response surrogate puts its chi2 at the fitted value this far
+  /// above the best chi2 any real run has reached gets no confirmation run: its chi2 is the
+  /// surrogate's (CandidateResult::chi2_source). 25 is a BIC weight below e^-12 of the leader's.
+  double confirm_margin = 25.0;
   bool suggest = true;  ///< simulate unmeasured settings to suggest a measurement
   int suggest_max = 4;  ///< at most this many settings tried
   std::function<void(const std::string&)> progress;
@@ -39,7 +43,13 @@ struct CandidateResult {
   EffectCandidate candidate;
   double fitted = 0.0;      ///< parameter value (candidate.unit)
   double fitted_std = 0.0;  ///< 1-sigma uncertainty from the fit's curvature (0: discrete)
-  Comparison comparison;    ///< against the data, from a real simulation at `fitted`
+  Comparison comparison;    ///< against the data, at `chi2_at` (see chi2_source)
+  /// How `comparison` was obtained: "run" (a simulation at `fitted`), "nearest_run" (the
+  /// simulation at `chi2_at`, within a quarter of the fitted uncertainty of `fitted`: Delta chi2
+  /// below ~0.06 by the fit's own curvature) or "surrogate" (no run: the response surrogate
+  /// puts this candidate at least DiagnoseOptions::confirm_margin above the best run).
+  std::string chi2_source = "run";
+  double chi2_at = 0.0;
   double delta_chi2 = 0.0;  ///< baseline chi2 - this chi2
   double bic = 0.0;
   bool plausible = true;  ///< fitted value inside the physical range, not pinned at a bound
@@ -71,6 +81,9 @@ struct Diagnosis {
 
 Diagnosis diagnose(const ParticleModel& baseline, const std::vector<Measurement>& measurements,
                    Simulator& simulator, const DiagnoseOptions& options);
+
+/// Where a candidate's chi2 comes from, in words: "run", "run at <value>" or "surrogate".
+std::string chi2_source_text(const CandidateResult& r);
 
 /// Survival function of the chi-square distribution, P(X >= x) with `dof` degrees of freedom.
 double chi2_survival(double x, int dof);

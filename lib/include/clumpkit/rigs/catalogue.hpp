@@ -24,6 +24,10 @@ struct SettingInfo {
   std::string unit;                  ///< unit of a numeric setting ("rpm"); empty for choices
   std::string default_value;
   std::string description;
+  /// A setting of the experiment itself (a wall material, a wheel speed), as opposed to one of
+  /// the simulation (scale, stiffness, implicit damping): only these are suggested as a next
+  /// measurement.
+  bool experimental = true;
 };
 
 struct RigInfo {
