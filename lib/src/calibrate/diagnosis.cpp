@@ -84,20 +84,22 @@ struct Surrogate {
     if (theta > hi) return at(hi) + slope(hi) * (theta - hi);
     return at(theta);
   }
-  // Variance of a simulated mean through the surrogate: the points' own seed scatter (std^2/n,
-  // pooled over the points that have it), else `fallback`. Heaps with more rolling friction
-  // scatter more than the baseline's (tiny scale: 2-4 deg against 1.6), so the baseline's
-  // scatter alone understated the fitted uncertainty.
-  double noise_var(const std::string& key, double fallback) const {
+  // Variance of a simulated mean through the surrogate, averaged over its points: each point's
+  // own seed scatter (std^2/n) where it has repeats, the pooled per-run variance `run_var` for
+  // a single-run (screening) point; never below the baseline's `run_var / base_n`. Heaps with
+  // more rolling friction scatter more than the baseline's (tiny scale: 2-4 deg against 1.6),
+  // so the baseline's scatter alone understated the fitted uncertainty.
+  double noise_var(const std::string& key, double run_var, int base_n) const {
+    const double floor = base_n > 0 ? run_var / base_n : run_var;
     double sum = 0.0;
     int k = 0;
     for (const auto& [t, v] : points) {
       const auto it = v.find(key);
-      if (it == v.end() || it->second.n < 2) continue;
-      sum += it->second.std * it->second.std / it->second.n;
+      if (it == v.end()) continue;
+      sum += it->second.n >= 2 ? it->second.std * it->second.std / it->second.n : run_var;
       ++k;
     }
-    return k > 0 ? std::max(fallback, sum / k) : fallback;
+    return k > 0 ? std::max(floor, sum / k) : floor;
   }
 
  private:
@@ -158,7 +160,7 @@ std::vector<double> fit_variances(const std::vector<Measurement>& ms, const Valu
   std::vector<double> var;
   for (const auto& m : ms) {
     const SimulatedValue& b = base.at(m.key());
-    var.push_back(m.std * m.std / m.n + s.noise_var(m.key(), b.n > 0 ? b.std * b.std / b.n : 0.0));
+    var.push_back(m.std * m.std / m.n + s.noise_var(m.key(), b.std * b.std, b.n));
   }
   return var;
 }
@@ -229,20 +231,20 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // (comparison.hpp): the spread of two repeats of one model is too uncertain to weigh by.
   SpreadPool pool(ms);
   std::set<std::string> pooled_models;
-  auto simulate = [&](const ParticleModel& m) {
-    Values v = simulate_measurements(sim, m, ms, o.scale, o.repeats, o.seed);
+  auto simulate = [&](const ParticleModel& m, int repeats) {
+    Values v = simulate_measurements(sim, m, ms, o.scale, repeats, o.seed);
     if (pooled_models.insert(model_fingerprint(m)).second) pool.add(v);
     return v;
   };
   // Runs that are known in advance are announced together, so a simulator can run them side
   // by side; the results (and so the diagnosis) do not depend on it.
   const std::vector<SimRequest> requests = requests_for(ms, o.scale);
-  auto prefetch = [&](const std::vector<ParticleModel>& models) {
+  auto prefetch = [&](const std::vector<ParticleModel>& models, int repeats) {
     std::vector<SimJob> jobs;
     for (const auto& m : models)
       for (const auto& r : requests) jobs.push_back({m, r});
     try {
-      sim.prefetch(jobs, o.repeats, o.seed);
+      sim.prefetch(jobs, repeats, o.seed);
     } catch (const NumericalError&) {
       // The failing run is made again where it is needed, and handled there.
     }
@@ -251,20 +253,30 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   const double ln_n = std::log(std::max(1, n));
 
   const std::vector<EffectCandidate> cands = effect_candidates(base, o.effects, &d.skipped);
+  const int screen = std::max(1, std::min(o.screen_repeats, o.repeats));
   {
-    std::vector<ParticleModel> first{base};
+    std::vector<ParticleModel> first;
     for (const auto& c : cands) {
       if (c.discrete)
         for (double level : c.levels) first.push_back(c.apply(base, level));
       else
         first.push_back(c.apply(base, c.probe));
     }
-    say(fmt::format("{} model variants to simulate first (baseline, probes, levels)",
-                    first.size()));
-    prefetch(first);
+    say(
+        fmt::format("{} model variants to simulate first: the baseline ({} repeats), probes and "
+                    "levels ({} repeat{} each)",
+                    first.size() + 1, o.repeats, screen, screen == 1 ? "" : "s"));
+    // The baseline's runs, then the screen's, each set side by side.
+    if (screen == o.repeats) {
+      first.insert(first.begin(), base);
+      prefetch(first, o.repeats);
+    } else {
+      prefetch({base}, o.repeats);
+      prefetch(first, screen);
+    }
   }
   say("baseline model " + base.name);
-  const Values s0 = simulate(base);
+  const Values s0 = simulate(base, o.repeats);
 
   struct Work {
     EffectCandidate c;
@@ -286,7 +298,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         double best = std::numeric_limits<double>::infinity();
         for (size_t i = 0; i < c.levels.size(); ++i) {
           say(fmt::format("{}: {}", c.effect, c.level_names[i]));
-          Values v = simulate(c.apply(base, c.levels[i]));
+          Values v = simulate(c.apply(base, c.levels[i]), screen);
           const double chi2 = compare(ms, pool.pooled(v), 1).chi2;
           if (chi2 < best) {
             best = chi2;
@@ -299,7 +311,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       } else {
         say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
         w.s.add(c.baseline, s0);
-        w.s.add(c.probe, simulate(c.apply(base, c.probe)));
+        w.s.add(c.probe, simulate(c.apply(base, c.probe), screen));
         w.fit = fit_surrogate(ms, pool.pooled(s0), w.s, c.lo, c.hi);
       }
     } catch (const NumericalError& e) {
@@ -322,13 +334,13 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   for (int step = 0; step < o.refinements && !refining.empty(); ++step) {
     std::vector<ParticleModel> models;
     for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
-    prefetch(models);
+    prefetch(models, o.repeats);
     std::vector<Work*> still;
     for (Work* w : refining) {
       say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
       Values v;
       try {
-        v = simulate(w->c.apply(base, w->fit.theta));
+        v = simulate(w->c.apply(base, w->fit.theta), o.repeats);
       } catch (const NumericalError& e) {
         say(fmt::format("{}: dropped: {}", w->c.effect, e.what()));
         d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
@@ -378,7 +390,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         SimulatedValue v;
         v.n = b.n;
         v.mean = w.s.value(m.key(), w.fit.theta);
-        v.std = b.n > 0 ? std::sqrt(w.s.noise_var(m.key(), b.std * b.std / b.n) * b.n) : b.std;
+        v.std = b.n > 0 ? std::sqrt(w.s.noise_var(m.key(), b.std * b.std, b.n) * b.n) : b.std;
         w.at_fit[m.key()] = v;
       }
       w.at = w.fit.theta;
@@ -395,12 +407,12 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   {  // the confirmation runs, side by side
     std::vector<ParticleModel> models;
     for (const Work* w : confirm) models.push_back(w->c.apply(base, w->fit.theta));
-    prefetch(models);
+    prefetch(models, o.repeats);
   }
   for (Work* w : confirm) {
     say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(w->fit.theta)));
     try {
-      w->at_fit = simulate(w->c.apply(base, w->fit.theta));
+      w->at_fit = simulate(w->c.apply(base, w->fit.theta), o.repeats);
     } catch (const NumericalError& e) {
       d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
                           w->c.format(w->fit.theta) + " failed: " + e.what());

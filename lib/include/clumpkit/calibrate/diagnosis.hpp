@@ -23,7 +23,11 @@ namespace clumpkit::calibrate {
 
 struct DiagnoseOptions {
   std::string scale = "mini";
-  int repeats = 2;
+  int repeats = 2;  ///< repeats of the baseline, the refinements and the confirmations
+  /// Repeats of the first phase's probes and discrete levels (a screen: the leaders are
+  /// simulated again at `repeats` when refined). Their variance comes from the spread pooled
+  /// over every variant with repeats.
+  int screen_repeats = 1;
   std::uint64_t seed = 1;
   std::vector<std::string> effects;  ///< empty: the whole catalogue
   int refinements = 2;               ///< real-run refinement steps for the leading candidates
