@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <limits>
 #include <random>
 #include <set>
@@ -92,6 +93,9 @@ TEST(Diagnosis, FindsEachHiddenEffect) {
     sum_chi2_per_dof += top.comparison.chi2_per_dof;
     EXPECT_GE(d.confidence, 0.5);
     EXPECT_FALSE(d.suggestions.empty());
+    // The verdict rests on runs with every repeat, not on the one-repeat screen (a discrete
+    // level that leads is simulated again).
+    for (const auto& ob : top.comparison.observables) EXPECT_EQ(ob.simulated.n, 2) << h.effect;
   }
   EXPECT_LE(sum_chi2_per_dof / std::size(cases), 1.5);
 }
@@ -143,6 +147,8 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
                std::abs(top.fitted - 0.2) <= 2.0 * top.fitted_std;
   }
   EXPECT_EQ(first, trials);
+  std::cout << "rolling friction ranked first in " << first << " of " << trials
+            << " trials, truth within 2 stated sigma in " << covered << "\n";
   // Nominal 2-sigma coverage is 95 % (38 of 40); measured 38. With a two-repeat spread and an
   // interpolating surrogate it was 19 of 40.
   EXPECT_GE(covered, 34) << covered << " of " << trials << " cover the truth";
@@ -235,7 +241,8 @@ TEST(Diagnosis, SkippingHopelessConfirmationsChangesNoVerdict) {
       EXPECT_LT(c.weight, 1e-4);
     }
     for (const auto& c : b.candidates) EXPECT_NE(c.chi2_source, "surrogate");
-    EXPECT_EQ(sim_b.runs() - sim_a.runs(), skipped * static_cast<long>(ms.size()));
+    // b also confirms the screened discrete levels that a cannot need.
+    EXPECT_GE(sim_b.runs() - sim_a.runs(), skipped * static_cast<long>(ms.size()));
     skipped_total += skipped;
   }
   EXPECT_GT(skipped_total, 0) << "the test needs a hopeless candidate to mean anything";

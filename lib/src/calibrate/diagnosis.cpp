@@ -369,12 +369,20 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     for (const auto& [t, v] : w.s.points)
       best_real = std::min(best_real, compare(ms, pool.pooled(v), 1).chi2);
   }
+  auto full = [&](const Values& v) { return !v.empty() && v.begin()->second.n >= o.repeats; };
   std::vector<Work*> confirm;
   for (Work& w : work) {
-    if (w.have_at_fit || w.dropped) continue;
+    if (w.dropped) continue;
+    if (w.c.discrete) {
+      // A screened level that could lead is simulated again with every repeat.
+      if (!full(w.at_fit) && w.fit.chi2 < best_real + o.confirm_margin) confirm.push_back(&w);
+      continue;
+    }
+    if (w.have_at_fit) continue;
+    // A point of the screen (one repeat) does not stand for a fit: only full-repeat runs do.
     const std::pair<double, Values>* nearest = nullptr;
     for (const auto& p : w.s.points)
-      if (std::abs(p.first - w.fit.theta) <= 0.25 * w.fit.sigma &&
+      if (full(p.second) && std::abs(p.first - w.fit.theta) <= 0.25 * w.fit.sigma &&
           (!nearest || std::abs(p.first - w.fit.theta) < std::abs(nearest->first - w.fit.theta)))
         nearest = &p;
     if (nearest) {
@@ -419,7 +427,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       w->dropped = true;
       continue;
     }
-    w->s.add(w->fit.theta, w->at_fit);
+    if (!w->c.discrete) w->s.add(w->fit.theta, w->at_fit);
     w->at = w->fit.theta;
     w->have_at_fit = true;
   }
