@@ -25,7 +25,7 @@ struct CalArgs {
   std::vector<std::string> models;
   std::string measurements, scale = "mini", json, report, cache = "clumpkit_cache", output;
   std::string effects;
-  int repeats = 2, threads = 0, jobs = 0;
+  int repeats = 2, threads = 0, jobs = 0, screen_repeats = 1;
   std::uint64_t seed = 1;
   bool apply = false, quiet = false, no_suggest = false;
   double noise = 0.03;
@@ -199,6 +199,12 @@ Command setup_diagnose(CLI::App& parent) {
   c->add_flag("--no-suggest", a->no_suggest,
               "Skip simulating unmeasured settings for the "
               "next-measurement suggestion");
+  c->add_option("--screen-repeats", a->screen_repeats,
+                "Repeats of the first phase's probes and discrete levels (a screen; the "
+                "leaders get --repeats when refined). Set it to --repeats for a full first "
+                "phase")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   common_options(c, *a);
   return {c, [a] {
             const auto ms = load_measurements(a->measurements);
@@ -220,6 +226,7 @@ Command setup_diagnose(CLI::App& parent) {
             DiagnoseOptions o;
             o.scale = a->scale;
             o.repeats = a->repeats;
+            o.screen_repeats = a->screen_repeats;
             o.seed = a->seed;
             o.suggest = !a->no_suggest;
             std::string list = a->effects;
