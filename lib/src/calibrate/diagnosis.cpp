@@ -362,7 +362,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // candidate the surrogate puts far behind the best real run is not simulated again (at
   // mini scale each confirmation is 4-8 rig runs, and such candidates are usually pinned at a
   // bound of their range); every other candidate gets a confirmation run at its fitted value.
-  double best_real = compare(ms, pool.pooled(s0), 0).chi2;
+  const Values pooled0 = pool.pooled(s0);  // the pool is final for this decision
+  double best_real = compare(ms, pooled0, 0).chi2;
   for (const Work& w : work) {
     if (w.dropped) continue;
     if (w.have_at_fit) best_real = std::min(best_real, compare(ms, pool.pooled(w.at_fit), 1).chi2);
@@ -392,7 +393,6 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       w.have_at_fit = true;
     } else if (w.fit.chi2 >= best_real + o.confirm_margin) {
       // The surrogate's prediction, each value with the variance the fit gave it.
-      const Values pooled0 = pool.pooled(s0);
       for (const auto& m : ms) {
         const SimulatedValue& b = pooled0.at(m.key());
         SimulatedValue v;
