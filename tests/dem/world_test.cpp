@@ -73,6 +73,28 @@ TEST(World, SameSeedSameHashForOneAndTwoThreads) {
   EXPECT_NE(a.state_hash(), c.state_hash());
 }
 
+// The neighbour list is a cache: which pairs it holds beyond the touching ones, and how often it
+// is rebuilt, must not change a bit of the trajectory. A skin of 3 % of the radius (cells just
+// over a diameter, a rebuild every few steps), the default, and four radii (cells of six radii)
+// bin the spheres into different cells and pair them from different cells; a pair missed at a
+// cell boundary, or listed twice, would change the hash.
+TEST(World, NeighbourSkinAndCellsDoNotChangeTheTrajectory) {
+  std::vector<std::uint64_t> hashes;
+  std::vector<long> rebuilds;
+  for (double skin : {3e-5, 0.0, 4e-3})
+    for (int threads : {1, 2}) {
+      WorldSettings s = pour(threads);
+      s.skin = skin;
+      World w = World::create(s);
+      stir(w);
+      for (int k = 0; k < 400; ++k) w.step();
+      hashes.push_back(w.state_hash());
+      rebuilds.push_back(w.profile().neighbour_rebuilds);
+    }
+  for (size_t k = 1; k < hashes.size(); ++k) EXPECT_EQ(hashes[k], hashes[0]) << "run " << k;
+  EXPECT_GT(rebuilds[0], 4 * rebuilds[2]) << "the skins should differ in their rebuilds";
+}
+
 TEST(World, CheckpointResumeIsBitIdentical) {
   const auto path = std::filesystem::path(CLUMPKIT_BINARY_DIR) / "dem_checkpoint_test.bin";
   World a = World::create(pour(1));

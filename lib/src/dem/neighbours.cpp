@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include <omp.h>
+
 #include "dem/world_impl.hpp"
 
 namespace clumpkit::dem {
@@ -22,6 +24,25 @@ std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
 std::int64_t cell_of(double v, double cell) {
   const double c = std::floor(v / cell);
   return static_cast<std::int64_t>(std::clamp(c, double(-kBias + 2), double(kBias - 2)));
+}
+
+// Sorts v by insertion, giving up (false, v then partly sorted) after `max_moves` moves.
+template <class T>
+bool insertion_sort(std::vector<T>& v, std::size_t max_moves) {
+  std::size_t moves = 0;
+  for (std::size_t k = 1; k < v.size(); ++k) {
+    if (!(v[k] < v[k - 1])) continue;
+    T x = v[k];
+    std::size_t m = k;
+    do {
+      v[m] = v[m - 1];
+      --m;
+    } while (m > 0 && x < v[m - 1]);
+    v[m] = x;
+    moves += k - m;
+    if (moves > max_moves) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -55,15 +76,22 @@ void World::Impl::rebuild_neighbours() {
 
   // Spheres sorted by cell, with their positions, radii and clumps copied in that order (the
   // candidates of one cell column are then contiguous in memory).
+  // The bins start in the last rebuild's order when the sphere count is unchanged: few spheres
+  // change cells between rebuilds, so an insertion sort is nearly linear. The sorted order is
+  // that of (key, sphere), a total order, so it does not depend on where the sort started.
   std::vector<std::pair<std::uint64_t, int>>& bins = scratch_bins;
-  bins.resize(ns);
+  const bool reuse = static_cast<int>(bins.size()) == ns;
+  if (!reuse) {
+    bins.resize(ns);
+    for (int s = 0; s < ns; ++s) bins[s].second = s;
+  }
   std::vector<std::array<std::int64_t, 3>> sc(ns);
 #pragma omp parallel for num_threads(threads) schedule(static) if (ns >= kParallelMin)
-  for (int s = 0; s < ns; ++s) {
+  for (int s = 0; s < ns; ++s)
     sc[s] = {cell_of(s_pos[s].x(), h), cell_of(s_pos[s].y(), h), cell_of(s_pos[s].z(), h)};
-    bins[s] = {cell_key(sc[s][0], sc[s][1], sc[s][2]), s};
-  }
-  std::sort(bins.begin(), bins.end());
+  for (auto& [key, s] : bins) key = cell_key(sc[s][0], sc[s][1], sc[s][2]);
+  if (!reuse || !insertion_sort(bins, 8 * static_cast<std::size_t>(ns)))
+    std::sort(bins.begin(), bins.end());
   std::vector<std::uint64_t> keys(ns);
   std::vector<Eigen::Vector4d> sorted(ns);  // x, y, z, r
   std::vector<int> sorted_clump(ns);
@@ -79,9 +107,13 @@ void World::Impl::rebuild_neighbours() {
   }
   const int nruns = static_cast<int>(runs.size());
   runs.push_back(ns);
-  // The three cells (x, y, z−1 … z+1) are consecutive keys (z is the low field), so each of
-  // the nine (dx, dy) columns around a cell is one binary search and one contiguous run of the
-  // sorted bins, looked up once per occupied cell.
+  // Half shell: each pair of spheres is tested once, from the cell with the smaller key. The 13
+  // neighbour cells with a larger key are the column (x, y, z+1) and the four columns
+  // (x, y+1), (x+1, y−1 … y+1), each three cells z−1 … z+1; a column's three cells are
+  // consecutive keys (z is the low field), so each is one binary search and one contiguous run
+  // of the sorted bins, looked up once per occupied cell. Within the sphere's own cell only the
+  // spheres after it in the sorted order are tested, and the own cell and (x, y, z+1) are one
+  // contiguous run.
   auto column = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
     const int lo = static_cast<int>(
         std::lower_bound(keys.begin(), keys.end(), cell_key(x, y, z - 1)) - keys.begin());
@@ -91,36 +123,61 @@ void World::Impl::rebuild_neighbours() {
     return std::array<int, 2>{lo, hi};
   };
 
-  // Sphere pairs, per sphere i the sorted list of j > i (lists kept between rebuilds so their
-  // storage is reused).
-  std::vector<std::vector<int>>& near = scratch_near;
-  near.resize(ns);
+  // Pairs found, per thread, as (smaller, larger) sphere index; gathered below into the list
+  // sorted by (i, j), which does not depend on which thread found what.
+  const int nt = std::max(1, threads);
+  std::vector<std::vector<std::array<int, 2>>>& found = scratch_found;
+  found.resize(nt);
+  for (auto& f : found) f.clear();
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (ns >= kParallelMin)
   for (int r = 0; r < nruns; ++r) {
+    auto& out = found[omp_get_thread_num()];
     const std::array<std::int64_t, 3>& c = sc[bins[runs[r]].second];
-    std::array<std::array<int, 2>, 9> cols;
-    for (int dx = -1, n = 0; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy) cols[n++] = column(c[0] + dx, c[1] + dy, c[2]);
+    const std::uint64_t above = cell_key(c[0], c[1], c[2] + 1);
+    int own_hi = runs[r + 1];
+    while (own_hi < ns && keys[own_hi] == above) ++own_hi;
+    const std::array<std::array<int, 2>, 4> cols = {
+        column(c[0], c[1] + 1, c[2]), column(c[0] + 1, c[1] - 1, c[2]),
+        column(c[0] + 1, c[1], c[2]), column(c[0] + 1, c[1] + 1, c[2])};
     for (int k = runs[r]; k < runs[r + 1]; ++k) {
       const int i = bins[k].second;
-      const Eigen::Vector4d& pi = sorted[k];
+      const Eigen::Vector4d pi = sorted[k];
       const int ci = sorted_clump[k];
-      auto& out = near[i];
-      out.clear();
-      for (const auto& [lo, hi] : cols)
+      auto test = [&](int lo, int hi) {
         for (int m = lo; m < hi; ++m) {
-          const int j = bins[m].second;
-          if (j <= i || sorted_clump[m] == ci) continue;
+          if (sorted_clump[m] == ci) continue;
           const double rr = pi[3] + sorted[m][3] + skin;
-          if ((pi.head<3>() - sorted[m].head<3>()).squaredNorm() < rr * rr) out.push_back(j);
+          if ((pi.head<3>() - sorted[m].head<3>()).squaredNorm() < rr * rr) {
+            const int j = bins[m].second;
+            out.push_back(i < j ? std::array<int, 2>{i, j} : std::array<int, 2>{j, i});
+          }
         }
-      std::sort(out.begin(), out.end());
+      };
+      test(k + 1, own_hi);
+      for (const auto& [lo, hi] : cols) test(lo, hi);
     }
   }
-  std::vector<PairEntry> next;
-  next.reserve(pairs.size() + pairs.size() / 8);
+  // Counting sort by i, then each i's partners sorted.
+  std::vector<int>& start = scratch_start;
+  start.assign(ns + 1, 0);
+  size_t npairs = 0;
+  for (const auto& f : found) {
+    npairs += f.size();
+    for (const auto& p : f) ++start[p[0] + 1];
+  }
+  for (int i = 0; i < ns; ++i) start[i + 1] += start[i];
+  std::vector<PairEntry> next(npairs);
+  {
+    std::vector<int>& fill = scratch_fill;
+    fill.assign(start.begin(), start.end() - 1);
+    for (const auto& f : found)
+      for (const auto& p : f) next[fill[p[0]]++] = {p[0], p[1]};
+  }
+#pragma omp parallel for num_threads(threads) schedule(static) if (ns >= kParallelMin)
   for (int i = 0; i < ns; ++i)
-    for (int j : near[i]) next.push_back({i, j});
+    if (start[i + 1] - start[i] > 1)
+      std::sort(next.begin() + start[i], next.begin() + start[i + 1],
+                [](const PairEntry& a, const PairEntry& b) { return a.j < b.j; });
   // Carry histories over (both lists are sorted by (i, j)).
   std::vector<ContactHistory> next_hist(next.size());
   size_t a = 0;
@@ -181,6 +238,10 @@ void World::Impl::rebuild_neighbours() {
       };
       // A wall at rest: one lookup for the cell (its frame is the world's).
       const auto rest_lo = at_rest[wi] ? lookup(keys[runs[r]]) : bins_w.end();
+      // A moving wall: the spheres of one cell mostly fall in one cell of the wall's frame, so
+      // the last look-up is kept.
+      std::uint64_t last_key = 0;
+      auto last_lo = bins_w.end();
       for (int k = runs[r]; k < runs[r + 1]; ++k) {
         const int s = bins[k].second;
         std::uint64_t key = keys[k];
@@ -188,7 +249,11 @@ void World::Impl::rebuild_neighbours() {
         if (!at_rest[wi]) {
           const Eigen::Vector3d x = wd.state.pose.unapply(s_pos[s]);
           key = cell_key(cell_of(x.x(), h), cell_of(x.y(), h), cell_of(x.z(), h));
-          lo = lookup(key);
+          if (k == runs[r] || key != last_key) {
+            last_key = key;
+            last_lo = lookup(key);
+          }
+          lo = last_lo;
         }
         const double reach = s_r[s] + skin;
         for (auto it = lo; it != bins_w.end() && it->first == key; ++it) {
