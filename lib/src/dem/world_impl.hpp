@@ -185,8 +185,8 @@ struct World::Impl {
   bool slot_overflow_warned = false;
   // Per-step scratch of detect_contacts (kept to avoid reallocation).
   std::vector<double> scratch_ratio;
-  std::vector<std::vector<std::array<int, 2>>> scratch_found;     // per thread, rebuild_neighbours
-  std::vector<int> scratch_start, scratch_fill;                     // rebuild_neighbours
+  std::vector<std::vector<std::array<int, 2>>> scratch_found;      // per thread, rebuild_neighbours
+  std::vector<int> scratch_start, scratch_fill;                    // rebuild_neighbours
   std::vector<std::vector<std::array<int, 2>>> scratch_cand;       // per sphere, rebuild_neighbours
   std::vector<std::pair<std::uint64_t, int>> scratch_bins;         // rebuild_neighbours
   std::vector<std::vector<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
