@@ -604,6 +604,22 @@ class Optimiser {
         lo = mid;
       }
     }
+    // Below the search's count, warm-started: the best fill less its least useful sphere,
+    // descended and polished, can still meet the target where a fill from scratch at that count
+    // did not (each budget is its own local optimum). Kept while the target holds.
+    while (s.size() > 1) {
+      const auto d = contributions(s);
+      const size_t worst = static_cast<size_t>(std::min_element(d.begin(), d.end()) - d.begin());
+      Spheres t = s;
+      t.erase(t.begin() + static_cast<std::ptrdiff_t>(worst));
+      step_ = 0.01 * ctx_.size;
+      refine(t, 20);
+      polish(t, 12, 2);
+      const double e = ctx_.errors(t).metric;
+      note({{"stage", "warm_prune"}, {"spheres", t.size()}, {"error", e}});
+      if (e > o_.max_error) break;
+      s = std::move(t);
+    }
   }
 
   FillContext ctx_;
