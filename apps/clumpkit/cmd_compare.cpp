@@ -250,7 +250,13 @@ Command setup_diagnose(CLI::App& parent) {
                   "{:<18} {:<38} {:>14} {:>10.3g} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {:<13} {}\n",
                   r.candidate.effect, r.candidate.parameter, r.candidate.format(r.fitted),
                   r.fitted_std, r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
-                  r.plausible ? "yes" : "no (at bound)", chi2_source_text(r));
+                  r.plausible  ? "yes"
+                  : r.at_limit ? "no (at limit)"
+                               : "no (at bound)",
+                  chi2_source_text(r));
+            for (const auto& r : d.candidates)
+              if (!r.limit.empty())
+                std::cout << "limit: " << r.candidate.effect << ": " << r.limit << "\n";
             for (const auto& s : d.skipped) std::cout << "not tried: " << s << "\n";
             std::cout << d.summary();
             std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n",
@@ -269,6 +275,8 @@ Command setup_diagnose(CLI::App& parent) {
                                {"weight", r.weight},
                                {"plausible", r.plausible},
                                {"at_bound", r.at_bound},
+                               {"limit", r.limit},
+                               {"at_limit", r.at_limit},
                                {"chi2_source", r.chi2_source},
                                {"chi2_at", r.chi2_at}});
             json sugg = json::array();

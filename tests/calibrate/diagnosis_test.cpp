@@ -200,6 +200,51 @@ TEST(Diagnosis, ACandidateThatCannotBeSimulatedIsSkippedWithItsReason) {
   EXPECT_NE(d.skipped.front().find("too flat"), std::string::npos);
 }
 
+// A hidden effect whose strength lies just below where the rigs stop measuring (strong
+// cohesion: past some strength the lifting tube carries the heap off, "no cone to measure").
+// The response is convex, so the secant from the probe overshoots into the failing region;
+// the failed run must narrow the candidate's range, not drop it: the refinement bisects back
+// toward the last measured value and the hidden effect is still found and fitted.
+TEST(Diagnosis, AFailedRunNarrowsTheRangeInsteadOfDroppingTheCandidate) {
+  struct Limited final : Simulator {
+    double limit = 15000.0;  // J/m^3: runs above fail
+    int failures = 0;
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      const double c = m.effects.cohesion.value_or(0.0);
+      if (c > limit) {
+        ++failures;
+        throw NumericalError("heap angle: the heap is only 5 mm high: no cone to measure");
+      }
+      ParticleModel convex = m;
+      if (c > 0) convex.effects.cohesion = c * c / 1e4;
+      ++runs_;
+      return inner.simulate(convex, r, repeats, seed);
+    }
+  } sim;
+  ParticleModel base = base_model();
+  set_model_effect(base, "effects.cohesion", "off", "test");
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.cohesion", "12000 J/m^3", "test");
+  const auto ms = synthesize(sim, truth, 0.02, 99);
+  DiagnoseOptions o;
+  o.suggest = false;
+  o.effects = {"cohesion", "rolling_friction", "particle_friction"};
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  std::cout << d.summary();
+  EXPECT_GE(sim.failures, 1) << "the first refinement should overshoot into the failing region";
+  ASSERT_EQ(d.verdict, "cohesion") << d.summary();
+  const CandidateResult& top = d.candidates.front();
+  EXPECT_NE(top.limit.find("could not measure"), std::string::npos) << top.limit;
+  EXPECT_NE(top.limit.find("no cone"), std::string::npos) << top.limit;
+  EXPECT_LT(top.fitted, sim.limit);
+  EXPECT_LE(std::abs(top.fitted - 12000.0), 2.0 * top.fitted_std + 1e-9)
+      << top.fitted << " +/- " << top.fitted_std;
+  EXPECT_EQ(top.chi2_source, "run");
+  for (const auto& s : d.skipped) EXPECT_EQ(s.find("cohesion"), std::string::npos) << s;
+}
+
 TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {
   EXPECT_NEAR(chi2_survival(3.841, 1), 0.05, 1e-4);
   EXPECT_NEAR(chi2_survival(18.307, 10), 0.05, 1e-4);

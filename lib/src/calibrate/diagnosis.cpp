@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "clumpkit/core/error.hpp"
@@ -287,10 +288,53 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     bool dropped = false;  ///< a run at its fitted value failed (reason in d.skipped)
     std::string source = "run";
     double at = 0.0;  ///< parameter value of at_fit
+    /// The values the rigs could measure: [lo_ok, hi_ok] within the candidate's range, narrowed
+    /// at a value where a run failed (`limit` says where and why); fits stay short of it
+    /// (fit_range), by half the way from the nearest measured value.
+    double lo_ok = 0.0, hi_ok = 0.0;
+    std::string limit;
+    int failures = 0;
   };
   std::vector<Work> work;
+  // A failed run at theta: the rigs cannot measure there (a heap that spreads flat, or that the
+  // lifting tube carries off; a run that blows up). The candidate's range ends at theta, on the
+  // side away from the nearest value that was measured.
+  auto cannot_measure = [&](Work& w, double theta, const std::string& why) {
+    double nearest = w.c.baseline;
+    for (const auto& p : w.s.points)
+      if (std::abs(p.first - theta) < std::abs(nearest - theta)) nearest = p.first;
+    if (theta > nearest)
+      w.hi_ok = std::min(w.hi_ok, theta);
+    else
+      w.lo_ok = std::max(w.lo_ok, theta);
+    ++w.failures;
+    w.limit = "the rigs could not measure at " + w.c.format(theta) + ": " + why;
+    say(fmt::format("{}: {}; fitting short of it", w.c.effect, w.limit));
+  };
+  // The range a fit may use: the measurable one, kept half the way short of a failed value
+  // from the nearest measured value (so refinements bisect toward a failure).
+  auto fit_range = [&](const Work& w) {
+    double lo = w.lo_ok, hi = w.hi_ok;
+    if (w.hi_ok < w.c.hi) {
+      double g = lo;
+      for (const auto& p : w.s.points)
+        if (p.first < w.hi_ok) g = std::max(g, p.first);
+      hi = 0.5 * (g + w.hi_ok);
+    }
+    if (w.lo_ok > w.c.lo) {
+      double g = hi;
+      for (const auto& p : w.s.points)
+        if (p.first > w.lo_ok) g = std::min(g, p.first);
+      lo = 0.5 * (g + w.lo_ok);
+    }
+    return std::pair<double, double>{lo, hi};
+  };
+  auto refit = [&](const Work& w) {
+    const auto [lo, hi] = fit_range(w);
+    return fit_surrogate(ms, pool.pooled(s0), w.s, lo, hi);
+  };
   for (const auto& c : cands) {
-    Work w{c, {}, {}, {}, false, false, "run", 0.0};
+    Work w{c, {}, {}, {}, false, false, "run", 0.0, c.lo, c.hi, "", 0};
     // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
     // the candidate out with the reason; it does not end the diagnosis.
     try {
@@ -311,8 +355,19 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       } else {
         say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
         w.s.add(c.baseline, s0);
-        w.s.add(c.probe, simulate(c.apply(base, c.probe), screen));
-        w.fit = fit_surrogate(ms, pool.pooled(s0), w.s, c.lo, c.hi);
+        double probe = c.probe;
+        Values v;
+        try {
+          v = simulate(c.apply(base, probe), screen);
+        } catch (const NumericalError& e) {
+          // Once more, half the way back to the baseline.
+          cannot_measure(w, probe, e.what());
+          probe = 0.5 * (c.baseline + probe);
+          say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(probe)));
+          v = simulate(c.apply(base, probe), screen);
+        }
+        w.s.add(probe, std::move(v));
+        w.fit = refit(w);
       }
     } catch (const NumericalError& e) {
       say(fmt::format("{}: not tried: {}", c.effect, e.what()));
@@ -328,32 +383,40 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
             [&](size_t a, size_t b) { return work[a].fit.chi2 < work[b].fit.chi2; });
   // Step by step over the leading candidates (each candidate's sequence is its own, so the
   // order does not change any result), so that one step's runs can go side by side.
+  // A failed run narrows the candidate's range and costs it no step: up to two failures each
+  // are followed by one more refinement (short of the failure) than `refinements`.
   std::vector<Work*> refining;
+  std::map<const Work*, int> steps_left;
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r)
-    if (!work[order[r]].c.discrete) refining.push_back(&work[order[r]]);
-  for (int step = 0; step < o.refinements && !refining.empty(); ++step) {
+    if (!work[order[r]].c.discrete && o.refinements > 0) {
+      refining.push_back(&work[order[r]]);
+      steps_left[refining.back()] = o.refinements;
+    }
+  while (!refining.empty()) {
     std::vector<ParticleModel> models;
     for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
     prefetch(models, o.repeats);
     std::vector<Work*> still;
     for (Work* w : refining) {
       say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
+      int& left = steps_left[w];
+      --left;
       Values v;
       try {
         v = simulate(w->c.apply(base, w->fit.theta), o.repeats);
       } catch (const NumericalError& e) {
-        say(fmt::format("{}: dropped: {}", w->c.effect, e.what()));
-        d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
-                            w->c.format(w->fit.theta) + " failed: " + e.what());
-        w->dropped = true;
+        cannot_measure(*w, w->fit.theta, e.what());
+        w->fit = refit(*w);
+        if (w->failures <= 2) ++left;
+        if (left > 0) still.push_back(w);
         continue;
       }
       w->s.add(w->fit.theta, v);
-      const Fit next = fit_surrogate(ms, pool.pooled(s0), w->s, w->c.lo, w->c.hi);
+      const Fit next = refit(*w);
       const bool converged =
           std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
       w->fit = next;
-      if (!converged) still.push_back(w);
+      if (!converged && left > 0) still.push_back(w);
     }
     refining = still;
   }
@@ -422,10 +485,24 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     try {
       w->at_fit = simulate(w->c.apply(base, w->fit.theta), o.repeats);
     } catch (const NumericalError& e) {
-      d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
-                          w->c.format(w->fit.theta) + " failed: " + e.what());
-      w->dropped = true;
-      continue;
+      // A continuous candidate is confirmed once more, short of the failure.
+      bool again = !w->c.discrete;
+      if (again) {
+        cannot_measure(*w, w->fit.theta, e.what());
+        w->fit = refit(*w);
+        say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(w->fit.theta)));
+        try {
+          w->at_fit = simulate(w->c.apply(base, w->fit.theta), o.repeats);
+        } catch (const NumericalError&) {
+          again = false;
+        }
+      }
+      if (!again) {
+        d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
+                            w->c.format(w->fit.theta) + " failed: " + e.what());
+        w->dropped = true;
+        continue;
+      }
     }
     if (!w->c.discrete) w->s.add(w->fit.theta, w->at_fit);
     w->at = w->fit.theta;
@@ -450,7 +527,14 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     const double span = w.c.hi - w.c.lo;
     r.at_bound =
         !w.c.discrete && (r.fitted <= w.c.lo + 0.01 * span || r.fitted >= w.c.hi - 0.01 * span);
-    r.plausible = w.c.discrete || (r.fitted >= w.c.lo && r.fitted <= w.c.hi && !r.at_bound);
+    r.limit = w.limit;
+    if (!w.c.discrete && !w.limit.empty()) {
+      const auto [lo, hi] = fit_range(w);
+      r.at_limit = (w.hi_ok < w.c.hi && r.fitted >= hi - 0.01 * span) ||
+                   (w.lo_ok > w.c.lo && r.fitted <= lo + 0.01 * span);
+    }
+    r.plausible =
+        w.c.discrete || (r.fitted >= w.c.lo && r.fitted <= w.c.hi && !r.at_bound && !r.at_limit);
     d.candidates.push_back(r);
   }
   std::sort(d.candidates.begin(), d.candidates.end(),
@@ -580,7 +664,10 @@ std::string Diagnosis::summary() const {
     s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}), confidence {:.2f}\n",
                      verdict, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
                      confidence);
-    if (!t.plausible)
+    if (t.at_limit)
+      s += "  warning: the fitted value is pinned at the edge of what the rigs could measure (" +
+           t.limit + "): the strength may be larger than fitted\n";
+    else if (!t.plausible)
       s += "  warning: the fitted value is pinned at the edge of its physical range: the effect "
            "it stands for may be the wrong one\n";
     for (const auto& dr : drivers) s += "  driven by " + dr + "\n";

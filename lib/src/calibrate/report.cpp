@@ -219,8 +219,14 @@ std::string report_html(const ReportInput& in) {
           "<td class=\"l\">{}</td></tr>\n",
           esc(r.candidate.effect), esc(r.candidate.parameter), esc(r.candidate.format(r.fitted)),
           r.fitted_std, r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
-          r.plausible ? "yes" : "no", esc(chi2_source_text(r)));
+          r.plausible  ? "yes"
+          : r.at_limit ? "no (at limit)"
+                       : "no",
+          esc(chi2_source_text(r)));
     h += "</table>\n";
+    for (const auto& r : in.diagnosis->candidates)
+      if (!r.limit.empty())
+        h += "<p class=\"limit\">" + esc(r.candidate.effect + ": " + r.limit) + "</p>\n";
   }
   h += "<h2>Observables</h2>\n<table id=\"observables\"><tr><th>rig</th><th>sample</th><th>setting"
        "</th><th>quantity</th><th>measured</th><th>&plusmn; std</th><th>simulated</th><th>&plusmn; "

@@ -58,6 +58,10 @@ struct CandidateResult {
   double bic = 0.0;
   bool plausible = true;  ///< fitted value inside the physical range, not pinned at a bound
   bool at_bound = false;
+  /// Where a run of this candidate failed, and why (empty if none did): the rigs could not
+  /// measure there, so the fit is kept short of it. at_limit: the fit is pinned against it.
+  std::string limit;
+  bool at_limit = false;
   double weight = 0.0;  ///< posterior weight among baseline + candidates (BIC)
 };
 
