@@ -243,17 +243,18 @@ void RigSimulator::prefetch(const std::vector<SimJob>& jobs, int repeats, std::u
     todo.push_back({std::move(e), j.request});
   }
   if (todo.size() < 2) return;
+  // A failed job does not stop the others (the caller makes it again where it is needed, and
+  // its rig folder keeps the failed repeat's last checkpoint, so that re-run is short); the
+  // first error is rethrown once all are done.
   std::atomic<size_t> next{0};
-  std::atomic<bool> failed{false};
   std::exception_ptr first_error;
   auto worker = [&] {
-    for (size_t i; !failed && (i = next++) < todo.size();) {
+    for (size_t i; (i = next++) < todo.size();) {
       try {
         run(todo[i].e, todo[i].req, repeats, seed, 1);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex_);
         if (!first_error) first_error = std::current_exception();
-        failed = true;
       }
     }
   };
