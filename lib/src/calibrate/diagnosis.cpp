@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <set>
 
 #include "clumpkit/core/error.hpp"
@@ -294,6 +293,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     double lo_ok = 0.0, hi_ok = 0.0;
     std::string limit;
     int failures = 0;
+    int steps_left = 0;  ///< refinement steps still allowed
   };
   std::vector<Work> work;
   // A failed run at theta: the rigs cannot measure there (a heap that spreads flat, or that the
@@ -334,7 +334,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     return fit_surrogate(ms, pool.pooled(s0), w.s, lo, hi);
   };
   for (const auto& c : cands) {
-    Work w{c, {}, {}, {}, false, false, "run", 0.0, c.lo, c.hi, "", 0};
+    Work w{c, {}, {}, {}, false, false, "run", 0.0, c.lo, c.hi, "", 0, o.refinements};
     // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
     // the candidate out with the reason; it does not end the diagnosis.
     try {
@@ -386,12 +386,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // A failed run narrows the candidate's range and costs it no step: up to two failures each
   // are followed by one more refinement (short of the failure) than `refinements`.
   std::vector<Work*> refining;
-  std::map<const Work*, int> steps_left;
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r)
-    if (!work[order[r]].c.discrete && o.refinements > 0) {
-      refining.push_back(&work[order[r]]);
-      steps_left[refining.back()] = o.refinements;
-    }
+    if (!work[order[r]].c.discrete && o.refinements > 0) refining.push_back(&work[order[r]]);
   while (!refining.empty()) {
     std::vector<ParticleModel> models;
     for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
@@ -399,7 +395,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     std::vector<Work*> still;
     for (Work* w : refining) {
       say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
-      int& left = steps_left[w];
+      int& left = w->steps_left;
       --left;
       Values v;
       try {
@@ -486,20 +482,22 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       w->at_fit = simulate(w->c.apply(base, w->fit.theta), o.repeats);
     } catch (const NumericalError& e) {
       // A continuous candidate is confirmed once more, short of the failure.
-      bool again = !w->c.discrete;
-      if (again) {
-        cannot_measure(*w, w->fit.theta, e.what());
+      std::string why = e.what();
+      bool confirmed = false;
+      if (!w->c.discrete) {
+        cannot_measure(*w, w->fit.theta, why);
         w->fit = refit(*w);
         say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(w->fit.theta)));
         try {
           w->at_fit = simulate(w->c.apply(base, w->fit.theta), o.repeats);
-        } catch (const NumericalError&) {
-          again = false;
+          confirmed = true;
+        } catch (const NumericalError& e2) {
+          why = e2.what();  // the reason at the value named below
         }
       }
-      if (!again) {
+      if (!confirmed) {
         d.skipped.push_back(w->c.effect + ": the run at its fitted value " +
-                            w->c.format(w->fit.theta) + " failed: " + e.what());
+                            w->c.format(w->fit.theta) + " failed: " + why);
         w->dropped = true;
         continue;
       }

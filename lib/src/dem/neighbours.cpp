@@ -257,10 +257,8 @@ void World::Impl::rebuild_neighbours() {
         }
         const double reach = s_r[s] + skin;
         for (auto it = lo; it != bins_w.end() && it->first == key; ++it) {
+          if (beyond_plane(wd, it->second, s_pos[s], reach)) continue;
           const auto& t = wd.triangles[it->second];
-          // The distance to the triangle is at least the distance to its plane.
-          if (std::abs((s_pos[s] - wd.vertices[t[0]]).dot(wd.normals[it->second])) >= reach)
-            continue;
           const Eigen::Vector3d c = closest_point_on_triangle(s_pos[s], wd.vertices[t[0]],
                                                               wd.vertices[t[1]], wd.vertices[t[2]]);
           if ((c - s_pos[s]).squaredNorm() < reach * reach) cand[s].push_back({wi, it->second});

@@ -393,10 +393,9 @@ void World::Impl::detect_contacts() {
     for (int k = wall_cand_start[s]; k < wall_cand_start[s + 1] && nc < 32; ++k) {
       const auto [wi, ti] = wall_cand[k];
       const WallData& wd = walls[wi];
+      // Most candidates (within the skin, not touching) stop at this one dot product.
+      if (beyond_plane(wd, ti, p, r)) continue;
       const auto& tri = wd.triangles[ti];
-      // The distance to the triangle is at least the distance to its plane: most candidates
-      // (within the skin, not touching) stop at this one dot product.
-      if (std::abs((p - wd.vertices[tri[0]]).dot(wd.normals[ti])) >= r) continue;
       const Eigen::Vector3d c = closest_point_on_triangle(p, wd.vertices[tri[0]],
                                                           wd.vertices[tri[1]], wd.vertices[tri[2]]);
       const double d = (p - c).norm();

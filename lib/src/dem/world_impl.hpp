@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <random>
@@ -277,5 +278,12 @@ struct Hasher {
 /// Closest point on triangle (a, b, c) to p.
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+/// True if p is at least `reach` from the plane of wall triangle `tri` (current vertices and
+/// normals), so at least that far from the triangle: the cheap test before the closest point.
+/// A degenerate triangle's zero normal never rejects.
+inline bool beyond_plane(const WallData& wd, int tri, const Eigen::Vector3d& p, double reach) {
+  return std::abs((p - wd.vertices[wd.triangles[tri][0]]).dot(wd.normals[tri])) >= reach;
+}
 
 }  // namespace clumpkit::dem

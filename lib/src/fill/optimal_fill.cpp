@@ -575,18 +575,7 @@ class Optimiser {
       refine(s, 40);
       return;
     }
-    // Drop the least useful spheres while the target still holds.
-    for (int guard = 0; guard < 1000 && s.size() > 1; ++guard) {
-      const auto d = contributions(s);
-      const size_t worst = static_cast<size_t>(std::min_element(d.begin(), d.end()) - d.begin());
-      Spheres t = s;
-      t.erase(t.begin() + static_cast<std::ptrdiff_t>(worst));
-      refine(t, 8);
-      const double e = ctx_.errors(t).metric;
-      if (e > o_.max_error) break;
-      s = std::move(t);
-      note({{"stage", "prune"}, {"spheres", s.size()}, {"error", e}});
-    }
+    prune(s, 8, 0, "prune");
     // Search below: full budget fills (seeding starts, descent, swaps, kicks) at fewer spheres,
     // bisecting between half the pruned count (assumed too few) and the pruned count.
     int hi = static_cast<int>(s.size()), lo = hi / 2 - 1;
@@ -606,19 +595,25 @@ class Optimiser {
     }
     // Below the search's count, warm-started: the best fill less its least useful sphere,
     // descended and polished, can still meet the target where a fill from scratch at that count
-    // did not (each budget is its own local optimum). Kept while the target holds.
-    while (s.size() > 1) {
+    // did not (each budget is its own local optimum).
+    prune(s, 20, 12, "warm_prune");
+  }
+
+  // Drops the least useful sphere while the target still holds: each trial is descended
+  // (`iters` steps) and, with `polish_sweeps` > 0, polished from a fresh step.
+  void prune(Spheres& s, int iters, int polish_sweeps, const char* stage) {
+    for (int guard = 0; guard < 1000 && s.size() > 1; ++guard) {
       const auto d = contributions(s);
       const size_t worst = static_cast<size_t>(std::min_element(d.begin(), d.end()) - d.begin());
       Spheres t = s;
       t.erase(t.begin() + static_cast<std::ptrdiff_t>(worst));
-      step_ = 0.01 * ctx_.size;
-      refine(t, 20);
-      polish(t, 12, 2);
+      if (polish_sweeps > 0) step_ = 0.01 * ctx_.size;
+      refine(t, iters);
+      if (polish_sweeps > 0) polish(t, polish_sweeps, 2);
       const double e = ctx_.errors(t).metric;
-      note({{"stage", "warm_prune"}, {"spheres", t.size()}, {"error", e}});
       if (e > o_.max_error) break;
       s = std::move(t);
+      note({{"stage", stage}, {"spheres", s.size()}, {"error", e}});
     }
   }
 
