@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -243,6 +244,75 @@ TEST(Diagnosis, AFailedRunNarrowsTheRangeInsteadOfDroppingTheCandidate) {
       << top.fitted << " +/- " << top.fitted_std;
   EXPECT_EQ(top.chi2_source, "run");
   for (const auto& s : d.skipped) EXPECT_EQ(s.find("cohesion"), std::string::npos) << s;
+}
+
+// Responses no parabola over the whole range follows: the packing may fall fast with the first
+// bit of cohesion and then level off (the mini cup: 700 kg/m^3 without, 411 at 2e4 J/m^3), or
+// barely move at the probe and then fast (the mini heaps: the secant from the 8000 J/m^3 probe
+// aimed at 4.7e4 for a truth of 2e4, where the heap could not be measured). A least-squares
+// parabola through the baseline, the probe and the refinements near the truth is biased where
+// the fit is made, and a parabola that turns over fell back to a line far from every point.
+// Measured over 16 lab-noise draws per shape (1 % seed noise per run, no common random
+// numbers, 2 % lab noise), truth 2e4 J/m^3:
+//   before (a global parabola or line, 2 refinements): the truth within 2 stated sigma in 0 and
+//   0 of 16, the chi2 at the fit plausible (p >= 0.01, 7 dof) in 1 and 0 of 16, and 5 of the
+//   accelerating draws gave the verdict to rolling friction pinned at its bound;
+//   after (points far from the fit dropped where the parabola misses them, a monotone parabola
+//   where the line misses them, up to 2 more steps for the leader): covered 11 (saturating)
+//   and 14 (accelerating) of 16, plausible 16 and 16, cohesion the verdict in all.
+// Where the response has levelled off the likelihood is skewed and the symmetric sigma short
+// on one side, so the coverage stays below the nominal 95 %.
+TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
+  struct Shaped final : Simulator {
+    std::function<double(double)> shape;  // cohesion -> the stand-in's (linear) cohesion
+    double limit = 4e4;                   // J/m^3: runs above fail (the tube lifts the heap)
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      ParticleModel s = m;
+      const double c = m.effects.cohesion.value_or(0.0);
+      if (c > limit) throw NumericalError("heap angle: the heap is only 5 mm high: no cone");
+      if (c > 0) s.effects.cohesion = shape(c);
+      ++runs_;
+      return inner.simulate(s, r, repeats, seed);
+    }
+  };
+  const std::pair<const char*, std::function<double(double)>> shapes[] = {
+      {"saturating", [](double c) { return 7.5e4 * (1.0 - std::exp(-c / 6e3)); }},
+      {"accelerating", [](double c) { return 1e4 * std::expm1(c / 1e4); }},
+  };
+  for (const auto& [name, shape] : shapes) {
+    int covered = 0, plausible = 0;
+    const int trials = 16;
+    for (int t = 0; t < trials; ++t) {
+      Shaped sim;
+      sim.shape = shape;
+      sim.inner.noise_rel = 0.01;
+      sim.inner.common_random_numbers = false;
+      ParticleModel base = base_model();
+      set_model_effect(base, "effects.cohesion", "off", "test");
+      ParticleModel truth = base;
+      set_model_effect(truth, "effects.cohesion", "20000 J/m^3", "test");
+      const auto ms = synthesize(sim, truth, 0.02, 500 + t);
+      DiagnoseOptions o;
+      o.suggest = false;
+      o.effects = {"cohesion", "rolling_friction", "particle_friction"};
+      o.seed = 1 + 100 * t;
+      const Diagnosis d = diagnose(base, ms, sim, o);
+      EXPECT_EQ(d.verdict, "cohesion") << name << "\n" << d.summary();
+      if (d.verdict != "cohesion") continue;
+      const CandidateResult& top = d.candidates.front();
+      const bool cov = std::abs(top.fitted - 20000.0) <= 2.0 * top.fitted_std;
+      const bool ok = chi2_survival(top.comparison.chi2, top.comparison.dof) >= 0.01;
+      std::cout << name << " " << t << ": cohesion " << top.fitted << " +/- " << top.fitted_std
+                << " (" << top.chi2_source << "), chi2 " << top.comparison.chi2 << " on "
+                << top.comparison.dof << " dof\n";
+      covered += cov;
+      plausible += ok;
+    }
+    EXPECT_GE(covered, 9) << name;
+    EXPECT_GE(plausible, trials - 1) << name;
+  }
 }
 
 TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {

@@ -55,13 +55,22 @@ using Values = std::map<std::string, SimulatedValue>;
 // surrogate smooths rather than interpolates: a piecewise-linear interpolant takes its slope
 // from the two nearest points, and two nearby refinement points give a slope that is mostly
 // seed noise (and with it a fitted uncertainty several times too small).
+// A rig's response over a candidate's whole range is often no parabola (the packing falls
+// fast with the first bit of cohesion, then levels off; a heap's angle rises slowly, then
+// steeply): where the parabola misses its points by more than their seed noise (a lack-of-fit
+// chi2 test at 1 %), the points farthest from the `focus` (where the fit is being made) are
+// dropped, down to three, so the surrogate is local where it must be and smooth where it can be.
 struct Surrogate {
+  /// A fit misses its points by more than their seed noise when a miss this large has a
+  /// probability below this (chi2 test).
+  static constexpr double kLackOfFit = 0.01;
   std::vector<std::pair<double, Values>> points;  // sorted by theta
 
   void add(double theta, Values v) {
     for (auto& p : points)
       if (p.first == theta) {
         p.second = std::move(v);
+        coef.clear();
         return;
       }
     points.emplace_back(theta, std::move(v));
@@ -69,9 +78,17 @@ struct Surrogate {
               [](const auto& a, const auto& b) { return a.first < b.first; });
     coef.clear();
   }
+  // Where the next fit is made, and the pooled seed-to-seed spread of one run per observable
+  // (the noise the lack-of-fit test weighs the points' misses by).
+  void aim(double theta, const Values& pooled) {
+    focus = theta;
+    run_var.clear();
+    for (const auto& [k, v] : pooled)
+      if (v.n >= 2 && std::isfinite(v.std) && v.std > 0) run_var[k] = v.std * v.std;
+    coef.clear();
+  }
   double value(const std::string& key, double theta) const {
     const Poly& c = poly(key);
-    const double lo = points.front().first, hi = points.back().first;
     auto at = [&](double t) {
       const double x = (t - c.mid) / c.half;
       return c.a + x * (c.b + x * c.c);
@@ -80,8 +97,8 @@ struct Surrogate {
       const double x = (t - c.mid) / c.half;
       return (c.b + 2.0 * c.c * x) / c.half;
     };
-    if (theta < lo) return at(lo) + slope(lo) * (theta - lo);
-    if (theta > hi) return at(hi) + slope(hi) * (theta - hi);
+    if (theta < c.lo) return at(c.lo) + slope(c.lo) * (theta - c.lo);
+    if (theta > c.hi) return at(c.hi) + slope(c.hi) * (theta - c.hi);
     return at(theta);
   }
   // Variance of a simulated mean through the surrogate, averaged over its points: each point's
@@ -105,30 +122,55 @@ struct Surrogate {
  private:
   struct Poly {
     double mid = 0, half = 1, a = 0, b = 0, c = 0;  ///< a + b x + c x^2, x = (t - mid) / half
+    double lo = 0, hi = 0;                          ///< span of the points it follows
   };
   mutable std::map<std::string, Poly> coef;
+  double focus = std::numeric_limits<double>::quiet_NaN();
+  std::map<std::string, double> run_var;
 
-  const Poly& poly(const std::string& key) const {
-    auto it = coef.find(key);
-    if (it != coef.end()) return it->second;
+  // (theta, mean, repeats) of the points, for one observable.
+  struct Pt {
+    double t, y;
+    int n;
+  };
+  // Lack of fit of `p` at the points, in units of their seed noise (`var`: one run's variance),
+  // as the probability of a miss this large from noise alone.
+  static double fits_within_noise(const Poly& p, const std::vector<Pt>& pts, double var) {
+    double miss = 0.0;
+    for (const Pt& q : pts) {
+      const double x = (q.t - p.mid) / p.half, r = p.a + x * (p.b + x * p.c) - q.y;
+      miss += r * r * std::max(1, q.n) / var;
+    }
+    const int dof = static_cast<int>(pts.size()) - (p.c != 0.0 ? 3 : 2);
+    return dof > 0 ? chi2_survival(miss, dof) : 1.0;
+  }
+  // `var`: one run's seed variance (0: unknown).
+  static Poly fit(const std::vector<Pt>& pts, double var) {
     Poly p;
-    const size_t n = points.size();
-    p.mid = 0.5 * (points.front().first + points.back().first);
-    p.half = std::max(0.5 * (points.back().first - points.front().first), 1e-300);
+    const size_t n = pts.size();
+    p.lo = pts.front().t;
+    p.hi = pts.front().t;
+    for (const Pt& q : pts) {
+      p.lo = std::min(p.lo, q.t);
+      p.hi = std::max(p.hi, q.t);
+    }
+    p.mid = 0.5 * (p.lo + p.hi);
+    p.half = std::max(0.5 * (p.hi - p.lo), 1e-300);
     if (n == 1) {
-      p.a = points[0].second.at(key).mean;
+      p.a = pts[0].y;
     } else if (n == 2) {
-      const double y0 = points[0].second.at(key).mean, y1 = points[1].second.at(key).mean;
+      const bool up = pts[0].t < pts[1].t;
+      const double y0 = up ? pts[0].y : pts[1].y, y1 = up ? pts[1].y : pts[0].y;
       p.a = 0.5 * (y0 + y1);
       p.b = 0.5 * (y1 - y0);  // x runs from -1 to 1 between the two points
     } else {
       // Normal equations of the least-squares parabola in x (well conditioned: |x| <= 1).
       double S[5] = {0, 0, 0, 0, 0}, T[3] = {0, 0, 0};
-      for (const auto& [t, v] : points) {
-        const double x = (t - p.mid) / p.half, y = v.at(key).mean;
+      for (const Pt& q : pts) {
+        const double x = (q.t - p.mid) / p.half;
         double xk = 1.0;
         for (int k = 0; k < 5; ++k) {
-          if (k < 3) T[k] += xk * y;
+          if (k < 3) T[k] += xk * q.y;
           S[k] += xk;
           xk *= x;
         }
@@ -140,13 +182,74 @@ struct Surrogate {
       p.b = q[1];
       p.c = q[2];
       // A parabola that turns over between the points is seed noise, not physics (the rigs'
-      // responses to one effect's strength are monotone over such a span): the least-squares
-      // line instead, which cannot trap the fit at a spurious extremum.
+      // responses to one effect's strength are monotone over such a span), and its extremum
+      // would trap the fit: the least-squares line instead. Where the line misses the points
+      // by more than their seed noise (`var`, one run's variance), the least-squares parabola
+      // that is monotone over the span: its vertex at one end of it (a response that barely
+      // moves at first and then fast, or one that levels off), whichever misses them least.
       if ((p.b - 2.0 * p.c) * (p.b + 2.0 * p.c) < 0.0) {
-        const double det = S[0] * S[2] - S[1] * S[1];
-        p.b = (S[0] * T[1] - S[1] * T[0]) / det;
-        p.a = (T[0] - p.b * S[1]) / S[0];
-        p.c = 0.0;
+        double best = std::numeric_limits<double>::infinity();
+        Poly mono = p, line = p;
+        // y = a + c u with u = (x - e)^2 (e = -1, +1), or u = x (the line).
+        for (int form = 0; form < 3; ++form) {
+          const double e = form == 0 ? -1.0 : 1.0;
+          auto u_of = [&](double x) { return form == 2 ? x : (x - e) * (x - e); };
+          double su = 0, sy = 0, suu = 0, suy = 0;
+          for (const Pt& pt : pts) {
+            const double u = u_of((pt.t - p.mid) / p.half);
+            su += u;
+            sy += pt.y;
+            suu += u * u;
+            suy += u * pt.y;
+          }
+          const double m = static_cast<double>(pts.size()), det = m * suu - su * su;
+          if (det <= 0.0) continue;
+          const double k = (m * suy - su * sy) / det, a0 = (sy - k * su) / m;
+          double sse = 0;
+          for (const Pt& pt : pts) {
+            const double r = a0 + k * u_of((pt.t - p.mid) / p.half) - pt.y;
+            sse += r * r;
+          }
+          if (form == 2) line.a = a0, line.b = k, line.c = 0.0;
+          if (sse >= best) continue;
+          best = sse;
+          if (form == 2) {
+            mono = line;
+          } else {
+            mono.a = a0 + k * e * e, mono.b = -2.0 * k * e, mono.c = k;
+          }
+        }
+        p = var > 0.0 && fits_within_noise(line, pts, var) < kLackOfFit ? mono : line;
+      }
+    }
+    return p;
+  }
+
+  const Poly& poly(const std::string& key) const {
+    auto it = coef.find(key);
+    if (it != coef.end()) return it->second;
+    std::vector<Pt> pts;
+    for (const auto& [t, v] : points) pts.push_back({t, v.at(key).mean, v.at(key).n});
+    const auto rv = run_var.find(key);
+    const double var = rv == run_var.end() ? 0.0 : rv->second;
+    Poly p = fit(pts, var);
+    if (std::isfinite(focus) && var > 0.0) {
+      // Nearest the focus first; drop from the far end while the fit misses its points.
+      std::stable_sort(pts.begin(), pts.end(), [&](const Pt& a, const Pt& b) {
+        return std::abs(a.t - focus) < std::abs(b.t - focus);
+      });
+      // Never down to points so close that the response between them is mostly seed noise
+      // (their slope, and with it the fitted uncertainty, would be noise): the points kept
+      // must span a change of at least four standard errors of a two-repeat mean.
+      auto spans_signal = [&](size_t n) {
+        double lo = pts[0].y, hi = pts[0].y;
+        for (size_t i = 1; i < n; ++i) lo = std::min(lo, pts[i].y), hi = std::max(hi, pts[i].y);
+        return hi - lo >= 4.0 * std::sqrt(var / 2.0);
+      };
+      while (pts.size() > 3 && fits_within_noise(p, pts, var) < kLackOfFit &&
+             spans_signal(pts.size() - 1)) {
+        pts.pop_back();
+        p = fit(pts, var);
       }
     }
     return coef.emplace(key, p).first->second;
@@ -294,6 +397,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     std::string limit;
     int failures = 0;
     int steps_left = 0;  ///< refinement steps still allowed
+    int extra_left = 0;  ///< further steps while it leads and has not converged
   };
   std::vector<Work> work;
   // A failed run at theta: the rigs cannot measure there (a heap that spreads flat, or that the
@@ -329,12 +433,17 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     }
     return std::pair<double, double>{lo, hi};
   };
-  auto refit = [&](const Work& w) {
+  // The surrogate is aimed at the last fit (where the new run was made) before it is fitted
+  // again.
+  auto refit = [&](Work& w) {
     const auto [lo, hi] = fit_range(w);
-    return fit_surrogate(ms, pool.pooled(s0), w.s, lo, hi);
+    const Values pooled = pool.pooled(s0);
+    w.s.aim(w.fit.theta, pooled);
+    return fit_surrogate(ms, pooled, w.s, lo, hi);
   };
   for (const auto& c : cands) {
-    Work w{c, {}, {}, {}, false, false, "run", 0.0, c.lo, c.hi, "", 0, o.refinements};
+    Work w{c,   {},   {},   {}, false, false,         "run",
+           0.0, c.lo, c.hi, "", 0,     o.refinements, o.extra_refinements};
     // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
     // the candidate out with the reason; it does not end the diagnosis.
     try {
@@ -412,6 +521,16 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       const bool converged =
           std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
       w->fit = next;
+      if (!converged && left == 0 && w->extra_left > 0) {
+        // The leader (by the surrogates' chi2) gets a few more steps to converge.
+        bool leads = true;
+        for (const Work& other : work)
+          if (&other != w && !other.dropped && other.fit.chi2 < w->fit.chi2) leads = false;
+        if (leads) {
+          --w->extra_left;
+          ++left;
+        }
+      }
       if (!converged && left > 0) still.push_back(w);
     }
     refining = still;

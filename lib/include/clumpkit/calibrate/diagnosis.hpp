@@ -32,7 +32,10 @@ struct DiagnoseOptions {
   std::vector<std::string> effects;  ///< empty: the whole catalogue
   int refinements = 2;               ///< real-run refinement steps for the leading candidates
   int refine_top = 3;                ///< how many leading candidates are refined
-  double min_delta_bic = 6.0;        ///< "strong" evidence (Kass & Raftery)
+  /// Further steps for the candidate whose fit leads, while its fit still moves by more than a
+  /// quarter of its uncertainty (a response far from a parabola converges in more steps).
+  int extra_refinements = 2;
+  double min_delta_bic = 6.0;  ///< "strong" evidence (Kass & Raftery)
   double p_inconsistent = 0.01;
   /// A continuous candidate whose response surrogate puts its chi2 at the fitted value this far
   /// above the best chi2 any real run has reached gets no confirmation run: its chi2 is the
