@@ -16,6 +16,7 @@ Cases (truth vs baseline; every other effect as in Table 1):
   cohesion           simplified-JKR energy density 2e4 J/m^3 pill-pill, baseline none
   wall_friction      mu_s pill-wall 0.9 on every wall, baseline 0.3
   shape_resolution   4 spheres per pill, baseline 12
+  particle_friction  mu_s pill-pill 0.2, baseline Table 1's 0.466
   none               truth = baseline (the diagnosis must not give a verdict)
 
 Writes OUT/results.md (a table) and OUT/<case>/ (models, data, JSON, HTML reports); the rig
@@ -66,6 +67,7 @@ CASES = {
     "wall_friction": ({"wall_friction": per_partner(0.9, WALLS)},
                       {"wall_friction": per_partner(0.3, WALLS)}, 0.9),
     "shape_resolution": ({"shape_resolution": ["spheres = 4"]}, {}, 4),
+    "particle_friction": ({"particle_friction": ["value = 0.2"]}, {}, 0.2),
     "none": ({}, {}, None),
 }
 
