@@ -315,6 +315,51 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
   }
 }
 
+// A hidden effect on the side of the baseline the candidate was not probed on, where the
+// response differs: pill-pill friction probed upward from Table 1's 0.466 (to 0.716) where the
+// heap has stopped feeling it, hidden at 0.2 where it feels it strongly (the mini heaps: 27-31
+// deg at 0.466 and 0.8, 21-25 deg at 0.2). Extrapolated from the flat side the surrogate saw
+// nothing: in the mini case of session 14 particle friction was not even refined (surrogate chi2
+// 49 at mu_s 0.013, the baseline's 46) and the verdict went to another effect. A screening run at
+// the mirrored probe gives the unprobed side a point. Without it this stand-in's verdict is
+// restitution pinned at its bound (particle friction 0.36, chi2 54 from its surrogate).
+TEST(Diagnosis, AnEffectOnTheUnprobedSideOfTheBaselineIsFound) {
+  struct Saturating final : Simulator {
+    fake::FakeSimulator inner;
+    int below = 0;  // runs below the baseline
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      ParticleModel s = m;
+      const double mu = m.effects.particle_friction.value_or(0.0);
+      below += mu < 0.46;
+      s.effects.particle_friction = 1.5 * (1.0 - std::exp(-mu / 0.15));
+      ++runs_;
+      return inner.simulate(s, r, repeats, seed);
+    }
+  };
+  for (std::uint64_t seed : {31u, 32u, 33u}) {
+    Saturating sim;
+    sim.inner.noise_rel = 0.01;
+    ParticleModel base = base_model();
+    set_model_effect(base, "effects.particle_friction", "0.466", "test");
+    ParticleModel truth = base;
+    set_model_effect(truth, "effects.particle_friction", "0.2", "test");
+    const auto ms = synthesize(sim, truth, 0.02, seed);
+    sim.below = 0;
+    DiagnoseOptions o;
+    o.suggest = false;
+    o.effects = {"particle_friction", "wall_friction", "restitution"};
+    o.seed = seed;
+    const Diagnosis d = diagnose(base, ms, sim, o);
+    EXPECT_GE(sim.below, 1) << "the unprobed side was never simulated";
+    ASSERT_EQ(d.verdict, "particle_friction") << d.summary();
+    const CandidateResult& top = d.candidates.front();
+    EXPECT_LE(std::abs(top.fitted - 0.2), 2.0 * top.fitted_std)
+        << top.fitted << " +/- " << top.fitted_std;
+    EXPECT_GE(chi2_survival(top.comparison.chi2, top.comparison.dof), 0.01) << d.summary();
+  }
+}
+
 TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {
   EXPECT_NEAR(chi2_survival(3.841, 1), 0.05, 1e-4);
   EXPECT_NEAR(chi2_survival(18.307, 10), 0.05, 1e-4);
