@@ -150,8 +150,8 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
   EXPECT_EQ(first, trials);
   std::cout << "rolling friction ranked first in " << first << " of " << trials
             << " trials, truth within 2 stated sigma in " << covered << "\n";
-  // Nominal 2-sigma coverage is 95 % (38 of 40); measured 38. With a two-repeat spread and an
-  // interpolating surrogate it was 19 of 40.
+  // Nominal 2-sigma coverage is 95 % (38 of 40); measured 37 (38 before session 14's local
+  // surrogate). With a two-repeat spread and an interpolating surrogate it was 19 of 40.
   EXPECT_GE(covered, 34) << covered << " of " << trials << " cover the truth";
 }
 
