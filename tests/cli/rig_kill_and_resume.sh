@@ -24,6 +24,13 @@ RANDOM=$$
 "$ck" "${args[@]}" --out "$dir/a" --json "$dir/a.json" > "$dir/a.log" 2>&1 ||
   { cat "$dir/a.log"; echo "FAIL: the uninterrupted run failed"; exit 1; }
 
+# The random delay of a kill is bounded by the uninterrupted repeat's wall time after its first
+# checkpoint (0.2 s): on an idle machine a tiny repeat takes ~0.7 s, and a fixed 0-500 ms delay
+# after repeat 2's first checkpoint let it finish before the kill (a fresh-clone run failed so).
+range_ms() {  # repeat index (0, 1) and cap in ms: 40 % of its time after the first checkpoint
+  python3 -c "import json,sys; w=json.load(open(sys.argv[1]))['repeats'][int(sys.argv[2])]['wall_seconds']; print(max(1, min(int(sys.argv[3]), int(400 * (w - 0.2)))))" "$dir/a.json" "$1" "$2"
+}
+
 # Starts run B in the background; waits for FILE to appear, then sleeps a random 0-RANGE ms and
 # SIGKILLs it. Fails if the run ends before it could be killed.
 kill_after() {  # file range_ms
@@ -42,10 +49,10 @@ kill_after() {  # file range_ms
 }
 
 # 1. Inside repeat 1, after its first checkpoint.
-kill_after "$dir/b/repeat_1/state.json" 800
+kill_after "$dir/b/repeat_1/state.json" "$(range_ms 0 800)"
 [ ! -f "$dir/b/repeat_1/result.json" ] || echo "note: repeat 1 had finished before the first kill"
 # 2. Resumed; killed inside repeat 2, after its first checkpoint (repeat 1 has finished then).
-kill_after "$dir/b/repeat_2/state.json" 500
+kill_after "$dir/b/repeat_2/state.json" "$(range_ms 1 500)"
 [ -f "$dir/b/repeat_1/result.json" ] || { echo "FAIL: repeat 2 began without repeat 1's result"; exit 1; }
 [ ! -f "$dir/b/repeat_2/result.json" ] || { echo "FAIL: repeat 2 finished before the kill"; exit 1; }
 before=$(stat -c '%i %Y.%y' "$dir/b/repeat_1/result.json"; sha256sum < "$dir/b/repeat_1/result.json")
