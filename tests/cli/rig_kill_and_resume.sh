@@ -28,7 +28,11 @@ RANDOM=$$
 # checkpoint (0.2 s): on an idle machine a tiny repeat takes ~0.7 s, and a fixed 0-500 ms delay
 # after repeat 2's first checkpoint let it finish before the kill (a fresh-clone run failed so).
 range_ms() {  # repeat index (0, 1) and cap in ms: 40 % of its time after the first checkpoint
-  python3 -c "import json,sys; w=json.load(open(sys.argv[1]))['repeats'][int(sys.argv[2])]['wall_seconds']; print(max(1, min(int(sys.argv[3]), int(400 * (w - 0.2)))))" "$dir/a.json" "$1" "$2"
+  python3 - "$dir/a.json" "$1" "$2" <<'PY'
+import json, sys
+wall = json.load(open(sys.argv[1]))["repeats"][int(sys.argv[2])]["wall_seconds"]
+print(max(1, min(int(sys.argv[3]), int(400 * (wall - 0.2)))))
+PY
 }
 
 # Starts run B in the background; waits for FILE to appear, then sleeps a random 0-RANGE ms and

@@ -442,8 +442,12 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     return fit_surrogate(ms, pooled, w.s, lo, hi);
   };
   for (const auto& c : cands) {
-    Work w{c,   {},   {},   {}, false, false,         "run",
-           0.0, c.lo, c.hi, "", 0,     o.refinements, o.extra_refinements};
+    Work w;
+    w.c = c;
+    w.lo_ok = c.lo;
+    w.hi_ok = c.hi;
+    w.steps_left = o.refinements;
+    w.extra_left = o.extra_refinements;
     // A variant the rigs cannot measure (a heap that spreads flat, a run that blows up) rules
     // the candidate out with the reason; it does not end the diagnosis.
     try {
