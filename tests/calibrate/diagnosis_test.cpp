@@ -64,6 +64,7 @@ TEST(Diagnosis, FindsEachHiddenEffect) {
       {"cohesion", "effects.cohesion", "9000 J/m^3", 9000.0},
       {"wall_friction", "effects.wall_friction", "0.45", 0.45},
       {"shape_resolution", "effects.shape_resolution", "4", 4.0},
+      {"size_distribution", "effects.size_distribution", "0.12", 0.12},
   };
   double sum_chi2_per_dof = 0.0;
   std::uint64_t seed = 4242;

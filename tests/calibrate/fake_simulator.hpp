@@ -28,6 +28,7 @@ class FakeSimulator final : public Simulator {
     const double mus = e.particle_friction.value_or(0.0);
     const double e_pp = partner(e.restitution, "pill") > 0 ? partner(e.restitution, "pill") : 1.0;
     const double coh = e.cohesion.value_or(0.0);
+    const double spread = e.size_distribution ? e.height_spread : 0.0;
     const int spheres = e.shape_resolution.value_or(model.types.front().paper_spheres.value_or(12));
     const std::string wall = r.settings.count("wall")    ? r.settings.at("wall")
                              : r.settings.count("plate") ? r.settings.at("plate")
@@ -35,19 +36,21 @@ class FakeSimulator final : public Simulator {
     const double muw = partner(e.wall_friction, wall);
     std::map<std::string, double> mean;
     if (r.rig == "bulk_density") {
-      // Rolling friction changes the packing little; cohesion opens it up (CALIBRATION.md).
+      // Rolling friction changes the packing little; cohesion opens it up (CALIBRATION.md); a
+      // spread of pill heights packs a little denser.
       mean["bulk_density"] = 760 - 120 * std::tanh(mus) - 10 * mur - 4e-3 * coh - 40 * muw +
-                             15 * (e_pp - 0.5) + 2.0 * (spheres - 12);
+                             15 * (e_pp - 0.5) + 2.0 * (spheres - 12) + 150 * spread;
     } else if (r.rig == "angle_of_repose") {
       // A free heap: wall (plate) friction matters little, cohesion and rolling friction a lot.
       const double a = 14 + 25 * std::tanh(2 * mur) + 8 * mus + 1.2e-3 * coh +
-                       1.5 * std::tanh(muw) - 0.3 * (20 - spheres) + 2 * (0.5 - e_pp);
+                       1.5 * std::tanh(muw) - 0.3 * (20 - spheres) + 2 * (0.5 - e_pp) - 10 * spread;
       mean["angle"] = a;
       mean["angle_left"] = a + 0.2;
       mean["angle_right"] = a - 0.2;
     } else {
       const double rpm = std::stod(r.settings.at("rpm"));
-      mean["pocket_mass"] = 0.25 - 0.0008 * (rpm - 10) - 0.02 * muw - 0.01 * mur - 4e-7 * coh;
+      mean["pocket_mass"] =
+          0.25 - 0.0008 * (rpm - 10) - 0.02 * muw - 0.01 * mur - 4e-7 * coh + 0.05 * spread;
       mean["pocket_mass_cv"] = 0.03 + 0.0004 * std::abs(rpm - 15) + 0.01 * mur;
       mean["mass_flow"] = mean["pocket_mass"] * 8 * rpm / 60;
     }

@@ -104,6 +104,113 @@ TEST(Model, MassBasisScalesMassAndInertiaTogether) {
               1e-9);
 }
 
+// A height spread (size_distribution): each type becomes three height classes whose
+// mass-weighted heights have the type's height as mean and the spread as relative std, each filled
+// by the type's paper rule so that its outer spheres touch its own end faces.
+TEST(Model, AHeightSpreadIsThreeHeightClassesWithTheSpreadsMoments) {
+  const ParticleModel m = parse(std::string(kHead) + R"(
+[effects]
+size_distribution = { height_spread = 0.1 }
+)");
+  EXPECT_TRUE(m.effects.size_distribution);
+  EXPECT_DOUBLE_EQ(m.effects.height_spread, 0.1);
+  const double h = m.types.front().shape.height;
+  const auto pop = m.population();
+  ASSERT_EQ(pop.size(), 3u);
+  EXPECT_EQ(pop[0].name, "A_short");
+  EXPECT_EQ(pop[1].name, "A");
+  EXPECT_EQ(pop[2].name, "A_tall");
+  double f = 0, mean = 0, second = 0;
+  for (const auto& t : pop) {
+    f += t.mass_fraction;
+    mean += t.mass_fraction * t.shape.height;
+    second += t.mass_fraction * t.shape.height * t.shape.height;
+  }
+  EXPECT_NEAR(f, 1.0, 1e-12);
+  EXPECT_NEAR(mean, h, 1e-12 * h);
+  EXPECT_NEAR(std::sqrt(second - mean * mean) / h, 0.1, 1e-9);
+
+  const auto clumps = m.clump_types(2000);
+  const auto mix = m.mixture();
+  ASSERT_EQ(clumps.size(), 3u);
+  ASSERT_EQ(mix.size(), 3u);
+  double last_mass = 0;
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(clumps[i].name, pop[i].name);
+    EXPECT_EQ(mix[i].clump_type, pop[i].name);
+    const auto& spheres = clumps[i].clump.spheres;
+    EXPECT_EQ(spheres.size(), 12u) << pop[i].name;  // the type's rule in every class
+    // The flat regime's 12-sphere rule: two layers whose spheres, of radius H / 3, touch the end
+    // faces of the class's own height H.
+    for (const auto& s : spheres)
+      EXPECT_NEAR(s.radius, pop[i].shape.height / 3, 1e-12) << pop[i].name;
+    EXPECT_GT(clumps[i].clump.mass.mass, last_mass) << pop[i].name;
+    last_mass = clumps[i].clump.mass.mass;
+  }
+  // The tall class of pill A (H 5.4 mm at D 6 mm: flat) is taller than wide, yet keeps the flat
+  // regime's 12-sphere rule (2 layers of 6), not the tall one's.
+  EXPECT_GT(pop[2].shape.height, pop[2].shape.diameter);
+
+  // Without a spread the population is the types.
+  EXPECT_EQ(parse(std::string(kHead) + "[effects]\nsize_distribution = true\n").population().size(),
+            1u);
+}
+
+TEST(Model, AHeightSpreadIsSetFromTheCommandLineAndItsErrorsNameTheKey) {
+  ParticleModel m = parse(kHead);
+  EXPECT_FALSE(m.effects.size_distribution);
+  set_model_effect(m, "effects.size_distribution", "0.05", "--set");
+  EXPECT_TRUE(m.effects.size_distribution);
+  EXPECT_DOUBLE_EQ(m.effects.height_spread, 0.05);
+  set_model_effect(m, "effects.size_distribution.height_spread", "0.08", "--set");
+  EXPECT_DOUBLE_EQ(m.effects.height_spread, 0.08);
+  set_model_effect(m, "effects.size_distribution", "on", "--set");  // keeps the spread
+  EXPECT_DOUBLE_EQ(m.effects.height_spread, 0.08);
+  set_model_effect(m, "effects.size_distribution", "off", "--set");
+  EXPECT_FALSE(m.effects.size_distribution);
+  EXPECT_EQ(m.effects.height_spread, 0.0);
+  auto set_error = [&](const std::string& key, const std::string& value) {
+    try {
+      set_model_effect(m, key, value, "--set");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(set_error("effects.size_distribution", "0.5").find("0.3"), std::string::npos);
+  EXPECT_NE(set_error("effects.size_distribution", "-0.1").find("size_distribution"),
+            std::string::npos);
+  EXPECT_NE(set_error("effects.size_distribution.width", "0.1").find("height_spread"),
+            std::string::npos);
+
+  std::string e = error_of(std::string(kHead) + R"(
+[effects.size_distribution]
+height_spread = 0.45
+)");
+  EXPECT_NE(e.find("effects.size_distribution.height_spread"), std::string::npos) << e;
+  e = error_of(std::string(kHead) + R"(
+[effects.size_distribution]
+spread = 0.1
+)");
+  EXPECT_NE(e.find("effects.size_distribution.spread"), std::string::npos) << e;
+  EXPECT_NE(e.find("height_spread"), std::string::npos) << e;
+  // A type given as a clump template has no rule to refill its height classes with.
+  e = error_of(std::string(R"(
+[model]
+name = "t"
+materials = "../materials.toml"
+[[types]]
+name = "A"
+shape = "../pill_A.toml"
+clump = ")") + CLUMPKIT_SOURCE_DIR +
+               R"(/tests/fuzz/corpus/clump_json/A4.json"
+[effects]
+size_distribution = { height_spread = 0.1 }
+)");
+  EXPECT_NE(e.find("effects.size_distribution.height_spread"), std::string::npos) << e;
+  EXPECT_NE(e.find("clump template"), std::string::npos) << e;
+}
+
 TEST(Model, ErrorsNameFileLineAndKey) {
   std::string e = error_of(std::string(kHead) + "[effects]\nstickiness = true\n");
   EXPECT_NE(e.find("test_model.toml"), std::string::npos) << e;

@@ -158,23 +158,14 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
     }
   }
   if (wanted("size_distribution")) {
-    if (base.types.size() < 2) {
-      skip("size_distribution", "the model has a single pill type");
-    } else if (!fx.size_distribution) {
-      EffectCandidate c;
-      c.effect = "size_distribution";
-      c.parameter = "pill types at their mass fractions";
-      c.unit = "";
-      c.discrete = true;
-      c.baseline = 0;
-      c.levels = {1};
-      c.level_names = {"size_distribution on"};
-      c.apply = [](const ParticleModel& m, double) {
-        return with(m, "effects.size_distribution", "on");
-      };
-      out.push_back(c);
-    } else {
-      skip("size_distribution", "already on; its fractions are fixed by the model file");
+    // The mixture's fractions are fixed by the model file (several types need it on); what can
+    // be missing is the spread of pill heights within each type.
+    try {
+      with(base, "effects.size_distribution", "0.1");
+      continuous("size_distribution", "height spread (mass-weighted relative std)", "1", 0.0, 0.2,
+                 fx.size_distribution ? fx.height_spread : 0.0, 0.1);
+    } catch (const InputError& e) {
+      skip("size_distribution", e.message());
     }
   }
   return out;

@@ -45,7 +45,10 @@ std::string format_model(const ParticleModel& m, const fs::path& target, const s
       "\n# Contact-law effects that are ON; an effect not listed is absent (SPEC §8).\n[effects]\n";
   if (e.particle_friction)
     s += fmt::format("particle_friction = {{ value = {:.10g} }}\n", *e.particle_friction);
-  if (e.size_distribution) s += "size_distribution = true\n";
+  if (e.size_distribution && e.height_spread > 0)
+    s += fmt::format("size_distribution = {{ height_spread = {:.10g} }}\n", e.height_spread);
+  else if (e.size_distribution)
+    s += "size_distribution = true\n";
   if (e.rolling_friction) s += partners("rolling_friction", *e.rolling_friction);
   if (e.wall_friction) s += partners("wall_friction", *e.wall_friction);
   if (e.restitution) s += partners("restitution", *e.restitution);

@@ -41,7 +41,9 @@ ParticleModel model_for_sample(const ParticleModel& model, const std::string& sa
     throw InputError(where, "sample",
                      "model '" + model.name + "' has no pill type '" + sample +
                          "' (types: " + known + "; use sample 'mix' for the whole population)");
-  if (m.types.size() < model.types.size()) m.effects.size_distribution = false;
+  // One type of several: its fractions go, its height spread (if any) stays.
+  if (m.types.size() < model.types.size() && m.effects.height_spread <= 0)
+    m.effects.size_distribution = false;
   return m;
 }
 
@@ -136,7 +138,10 @@ std::string model_fingerprint(const ParticleModel& m) {
     << (e.particle_friction ? fmt::format("{:.17g}", *e.particle_friction) : "absent") << "\n";
   s << "cohesion " << (e.cohesion ? fmt::format("{:.17g}", *e.cohesion) : "absent") << "\n";
   s << "shape_resolution " << e.shape_resolution.value_or(0) << "\n";
-  s << "size_distribution " << e.size_distribution << "\n";
+  // One type without a height spread is one size whether the effect is listed or not.
+  s << "size_distribution " << (e.size_distribution && (m.types.size() > 1 || e.height_spread > 0));
+  if (e.size_distribution && e.height_spread > 0) s << fmt::format(" {:.17g}", e.height_spread);
+  s << "\n";
   s << "rolling_model " << (e.rolling_model ? dem::to_string(*e.rolling_model) : "default") << " "
     << e.epsd_damping << "\n";
   return s.str();

@@ -84,6 +84,18 @@ std::map<std::string, double> partner_values(const TomlDoc& doc, const std::stri
 }
 
 // Effect tables are either `name = true` / `name = false` or a table `[effects.name]`.
+// A height spread splits paper-rule cylinders into height classes; "" when every type is one.
+std::string height_spread_blocker(const ParticleModel& m) {
+  for (const ModelType& t : m.types) {
+    if (t.shape.kind != ShapeSpec::Kind::Cylinder)
+      return "a height spread needs cylinder shapes (type " + t.name + " is a mesh)";
+    if (!t.paper_spheres && !m.effects.shape_resolution)
+      return "a height spread refills each height class by the paper rule (type " + t.name +
+             " uses a clump template)";
+  }
+  return "";
+}
+
 bool effect_listed(const TomlDoc& doc, const std::string& e, bool& as_table) {
   const std::string key = "effects." + e;
   as_table = false;
@@ -271,10 +283,20 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
     doc.fail("effects",
              "a model with several types needs effects.size_distribution = true "
              "(without it the population has one size)");
-  if (fx.size_distribution && tbl)
+  if (fx.size_distribution && tbl) {
+    const std::string key = "effects.size_distribution.height_spread";
     for (const auto& k : doc.keys("effects.size_distribution"))
-      doc.fail("effects.size_distribution." + k,
-               "unknown key (the fractions are the types' mass_fraction)");
+      if (k != "height_spread")
+        doc.fail("effects.size_distribution." + k,
+                 "unknown key (known: height_spread; the fractions are the types' "
+                 "mass_fraction)");
+    if (auto s = doc.number_opt(key)) {
+      doc.require_range(key, *s, 0.0, kMaxHeightSpread);
+      fx.height_spread = *s;
+      if (const std::string why = height_spread_blocker(m); *s > 0 && !why.empty())
+        doc.fail(key, why);
+    }
+  }
   if (effect_listed(doc, "rolling_model", tbl)) {
     if (!tbl || !doc.has("effects.rolling_model.model"))
       doc.fail("effects.rolling_model",
@@ -299,13 +321,48 @@ ParticleModel load_model(const fs::path& path, const fs::path& data_dir) {
   return parse_model(read_file(path), path, data_dir);
 }
 
+std::vector<ModelType> ParticleModel::population() const {
+  if (!effects.size_distribution || effects.height_spread <= 0) return types;
+  if (const std::string why = height_spread_blocker(*this); !why.empty())
+    throw InputError(path.string(), "effects.size_distribution.height_spread", why);
+  // Three-point Gauss–Hermite classes of the mass-weighted height distribution.
+  struct HeightClass {
+    const char* suffix;
+    double z, fraction;
+  };
+  const double z = std::sqrt(3.0);
+  const HeightClass classes[] = {
+      {"_short", -z, 1.0 / 6}, {"", 0.0, 2.0 / 3}, {"_tall", z, 1.0 / 6}};
+  std::vector<ModelType> out;
+  for (const ModelType& t : types)
+    for (const HeightClass& k : classes) {
+      ModelType c = t;
+      c.name = t.name + k.suffix;
+      c.height_factor = 1.0 + effects.height_spread * k.z;
+      c.shape.height *= c.height_factor;
+      c.mass_fraction = t.mass_fraction * k.fraction;
+      if (c.given_mass) *c.given_mass *= c.height_factor;  // one diameter: mass in proportion
+      out.push_back(std::move(c));
+    }
+  return out;
+}
+
 std::vector<dem::ClumpTypeSettings> ParticleModel::clump_types(long rays) const {
   std::vector<dem::ClumpTypeSettings> out;
-  for (const ModelType& t : types) {
+  for (const ModelType& t : population()) {
     ClumpTemplate c;
     if (t.paper_spheres || effects.shape_resolution) {
       PaperFillRequest req;
       req.spheres = effects.shape_resolution ? *effects.shape_resolution : *t.paper_spheres;
+      // A height class keeps its type's rule (the regime of the type's own height).
+      if (t.height_factor != 1.0) {
+        const double h = t.shape.height / t.height_factor;
+        try {
+          req.custom = paper_preset(regime(t.shape.diameter, h), req.spheres);
+        } catch (const InputError& e) {
+          throw e.at(t.shape_path.string());
+        }
+      }
       req.sampling.rays = rays;
       if (t.clump_path.empty() || effects.shape_resolution)
         c = paper_fill_template(t.shape, req);
@@ -382,7 +439,7 @@ void ParticleModel::configure(dem::WorldSettings& ws, const std::vector<std::str
 
 std::vector<dem::MixtureEntry> ParticleModel::mixture() const {
   std::vector<dem::MixtureEntry> m;
-  for (const auto& t : types) m.push_back({t.name, t.mass_fraction});
+  for (const auto& t : population()) m.push_back({t.name, t.mass_fraction});
   return m;
 }
 
@@ -396,6 +453,8 @@ std::string ParticleModel::summary() const {
   s += "; effects on:";
   for (const auto& e : effect_names())
     if (effects.on(e)) s += " " + e;
+  if (effects.size_distribution && effects.height_spread > 0)
+    s += fmt::format(" (height spread {:.3g})", effects.height_spread);
   return s;
 }
 
@@ -437,6 +496,7 @@ void set_model_effect(ParticleModel& m, const std::string& key, const std::strin
       if (m.types.size() > 1)
         throw InputError(where, key, "the model has several types; edit the model file instead");
       fx.size_distribution = false;
+      fx.height_spread = 0.0;
     }
     return;
   }
@@ -474,7 +534,17 @@ void set_model_effect(ParticleModel& m, const std::string& key, const std::strin
   } else if (name == "shape_resolution") {
     fx.shape_resolution = int(parse_number(value, where, key, 1, 1000));
   } else if (name == "size_distribution") {
+    // "on", or a number: the height spread (effects.size_distribution=0.05 or
+    // effects.size_distribution.height_spread=0.05).
+    if (!partner.empty() && partner != "height_spread")
+      throw InputError(where, key, "size_distribution has one parameter: height_spread");
+    double spread = fx.size_distribution ? fx.height_spread : 0.0;
+    if (value != "on") spread = parse_number(value, where, key, 0.0, kMaxHeightSpread);
+    if (spread > 0)
+      if (const std::string why = height_spread_blocker(m); !why.empty())
+        throw InputError(where, key, why);
     fx.size_distribution = true;
+    fx.height_spread = spread;
   } else if (name == "rolling_model") {
     if (!fx.rolling_friction)
       throw InputError(where, key, "a rolling model needs rolling_friction on");

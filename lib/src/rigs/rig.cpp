@@ -205,9 +205,10 @@ dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& w
 
 double mean_union_density(const Ctx& c) {
   double v = 0, m = 0;
+  const std::vector<dem::MixtureEntry> mix = c.req.model.mixture();
   for (const auto& t : c.types)
-    for (const auto& mt : c.req.model.types)
-      if (mt.name == t.name) m += mt.mass_fraction, v += mt.mass_fraction / t.clump.mass.density;
+    for (const auto& e : mix)
+      if (e.clump_type == t.name) m += e.mass_fraction, v += e.mass_fraction / t.clump.mass.density;
   return m / v;
 }
 

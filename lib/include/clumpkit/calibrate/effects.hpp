@@ -26,9 +26,9 @@ struct EffectCandidate {
 };
 
 /// Candidates for a baseline model. `only` (effect ids) restricts the list; unknown ids throw
-/// InputError naming `where`. Effects that cannot be tried on this model (size_distribution on a
-/// single-type model; rolling_model without rolling friction) are skipped and named in
-/// `skipped` with the reason.
+/// InputError naming `where`. Effects that cannot be tried on this model (a height spread of
+/// size_distribution on a type that is not a paper-rule cylinder; rolling_model without rolling
+/// friction) are skipped and named in `skipped` with the reason.
 std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
                                                const std::vector<std::string>& only,
                                                std::vector<std::string>* skipped,

@@ -39,7 +39,13 @@ struct ModelType {
   std::filesystem::path clump_path;  ///< or a clump template file (clumpkit-clump/1)
   double mass_fraction = 1.0;        ///< normalised over the model's types
   std::optional<double> given_mass;  ///< kg per pill, basis `given`
+  /// A height class of a size distribution (ParticleModel::population()): the shape's height is
+  /// the type's times this factor, filled by the type's paper rule of its own regime.
+  double height_factor = 1.0;
 };
+
+/// The largest height spread a model may state: the short class keeps 48 % of the height.
+inline constexpr double kMaxHeightSpread = 0.3;
 
 /// Values of the effects that are on. Per-partner values (key = the other material, "pill" for
 /// pill–pill) default to the materials library's interaction with the pill.
@@ -51,6 +57,9 @@ struct ModelEffects {
   std::optional<double> cohesion;       ///< simplified JKR energy density, J/m^3 (pill–pill)
   std::optional<int> shape_resolution;  ///< sphere count forced on every paper-rule type
   bool size_distribution = false;       ///< on: the types' mass fractions are used
+  /// size_distribution: relative standard deviation of every type's pill height, 1 (0: one
+  /// height per type). The DEM sees each type as three height classes (population()).
+  double height_spread = 0.0;
   std::optional<dem::RollingModel> rolling_model;  ///< absent: EDEM standard
   double epsd_damping = 0.3;                       ///< rolling_model = epsd: viscous damping ratio
 
@@ -67,8 +76,14 @@ struct ParticleModel {
   std::vector<ModelType> types;
   ModelEffects effects;
 
-  /// Clump templates of the types (filled by the paper rule or loaded), with the mass basis
-  /// applied. `rays` sets the ray sampling of the union's mass properties.
+  /// The pill types the DEM sees: the model's types, or, with a height spread s, each type split
+  /// into three height classes h(1 - s√3), h, h(1 + s√3) at number fractions 1/6, 2/3, 1/6 (the
+  /// three-point Gauss–Hermite rule: the classes keep the height's mean and standard deviation),
+  /// named NAME_short, NAME, NAME_tall, with mass fractions in proportion to their pill masses.
+  /// Throws InputError for a spread on a type that is not a paper-rule cylinder.
+  std::vector<ModelType> population() const;
+  /// Clump templates of the population's types (filled by the paper rule or loaded), with the
+  /// mass basis applied. `rays` sets the ray sampling of the union's mass properties.
   std::vector<dem::ClumpTypeSettings> clump_types(long rays = 20000) const;
   /// The DEM contact laws of every pill pair and pill–wall pair for `wall_materials`, with the
   /// absent effects removed. Throws InputError for a wall material the library lacks.
@@ -77,7 +92,7 @@ struct ParticleModel {
   /// Writes materials, clump types, rolling model and pair laws into `ws`.
   void configure(dem::WorldSettings& ws, const std::vector<std::string>& wall_materials,
                  long rays = 20000) const;
-  /// Mixture for a factory: type name and normalised mass fraction.
+  /// Mixture for a factory: the population's type names and normalised mass fractions.
   std::vector<dem::MixtureEntry> mixture() const;
   /// A short description of the model and its effects, SI units.
   std::string summary() const;
