@@ -17,6 +17,10 @@ Cases (truth vs baseline; every other effect as in Table 1):
   wall_friction      mu_s pill-wall 0.9 on every wall, baseline 0.3
   shape_resolution   4 spheres per pill, baseline 12
   particle_friction  mu_s pill-pill 0.2, baseline Table 1's 0.466
+  restitution        e 0.7 on every pair, baseline Table 1's 0.20-0.31
+  rolling_model      LIGGGHTS' CDT rolling model, baseline the standard one (eq. 2), both at
+                     Table 1's mu_r
+  size_distribution  a height spread of 0.15 (mass-weighted relative std), baseline one height
   none               truth = baseline (the diagnosis must not give a verdict)
 
 Writes OUT/results.md (a table) and OUT/<case>/ (models, data, JSON, HTML reports); the rig
@@ -49,7 +53,7 @@ def model(name, source, materials, extra):
             tables += [f"[effects.{e}]"] + extra[e]
         else:
             lines.append(f"{e} = true")
-    for e in ["cohesion", "shape_resolution"]:
+    for e in ["cohesion", "shape_resolution", "rolling_model", "size_distribution"]:
         if e in extra:
             tables += [f"[effects.{e}]"] + extra[e]
     return "\n".join(lines + tables) + "\n"
@@ -68,6 +72,9 @@ CASES = {
                       {"wall_friction": per_partner(0.3, WALLS)}, 0.9),
     "shape_resolution": ({"shape_resolution": ["spheres = 4"]}, {}, 4),
     "particle_friction": ({"particle_friction": ["value = 0.2"]}, {}, 0.2),
+    "restitution": ({"restitution": per_partner(0.7, ["pill"] + WALLS)}, {}, 0.7),
+    "rolling_model": ({"rolling_model": ['model = "cdt"']}, {}, "cdt"),
+    "size_distribution": ({"size_distribution": ["height_spread = 0.15"]}, {}, 0.15),
     "none": ({}, {}, None),
 }
 
