@@ -206,132 +206,137 @@ Command setup_diagnose(CLI::App& parent) {
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   common_options(c, *a);
-  return {c, [a] {
-            const auto ms = load_measurements(a->measurements);
-            warn_redundant(ms, a->measurements);
-            if (ms.size() < 3)
-              throw InputError(a->measurements, "",
-                               fmt::format("{} observable(s) are too few to tell effects apart "
-                                           "(need at least 3)",
-                                           ms.size()));
-            const ParticleModel base = load_model(find_model(a->models.front()), data_dir());
-            if (a->apply && a->output.empty())
-              throw InputError("", "--output", "--apply needs -o NEW_MODEL.toml");
-            if (!a->output.empty()) check_writable(a->output, "--output");
-            if (!a->report.empty()) {
-              std::error_code ec;
-              std::filesystem::create_directories(a->report, ec);
-            }
-            check_outputs(*a);
-            DiagnoseOptions o;
-            o.scale = a->scale;
-            o.repeats = a->repeats;
-            o.screen_repeats = a->screen_repeats;
-            o.seed = a->seed;
-            o.suggest = !a->no_suggest;
-            std::string list = a->effects;
-            for (size_t p; (p = list.find(',')) != std::string::npos; list.erase(0, p + 1))
-              if (p > 0) o.effects.push_back(list.substr(0, p));
-            if (!list.empty()) o.effects.push_back(list);
-            effect_candidates(base, o.effects, nullptr, "--effects");  // names checked up front
-            if (!a->quiet)
-              o.progress = [](const std::string& s) { std::cerr << "diagnose: " << s << "\n"; };
-            RigSimulator sim = make_sim(*a);
-            const Diagnosis d = diagnose(base, ms, sim, o);
-            std::cout << fmt::format(
-                "{:<18} {:<38} {:>14} {:>10} {:>9} {:>9} {:>9} {:>7} {:<13} {}\n", "effect",
-                "parameter", "fitted", "+/-", "chi2", "dchi2", "BIC", "weight", "plausible",
-                "chi2 from");
-            std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>9.2f} {:>9} {:>9.2f}\n",
-                                     "(baseline)", base.name, "", "", d.baseline.chi2, "",
-                                     d.baseline_bic);
-            for (const auto& r : d.candidates)
-              std::cout << fmt::format(
-                  "{:<18} {:<38} {:>14} {:>10.3g} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {:<13} {}\n",
-                  r.candidate.effect, r.candidate.parameter, r.candidate.format(r.fitted),
-                  r.fitted_std, r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
-                  r.plausible  ? "yes"
-                  : r.at_limit ? "no (at limit)"
-                               : "no (at bound)",
-                  chi2_source_text(r));
-            for (const auto& r : d.candidates)
-              if (!r.limit.empty())
-                std::cout << "limit: " << r.candidate.effect << ": " << r.limit << "\n";
-            for (const auto& s : d.skipped) std::cout << "not tried: " << s << "\n";
-            std::cout << d.summary();
-            std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n",
-                                     sim.runs(), sim.cache_hits());
-            json cands = json::array();
-            for (const auto& r : d.candidates)
-              cands.push_back({{"effect", r.candidate.effect},
-                               {"parameter", r.candidate.parameter},
-                               {"unit", r.candidate.unit},
-                               {"fitted", {{"value", r.fitted}, {"std", r.fitted_std}}},
-                               {"range", {r.candidate.lo, r.candidate.hi}},
-                               {"chi2", r.comparison.chi2},
-                               {"chi2_per_dof", r.comparison.chi2_per_dof},
-                               {"delta_chi2", r.delta_chi2},
-                               {"bic", r.bic},
-                               {"weight", r.weight},
-                               {"plausible", r.plausible},
-                               {"at_bound", r.at_bound},
-                               {"limit", r.limit},
-                               {"at_limit", r.at_limit},
-                               {"chi2_source", r.chi2_source},
-                               {"chi2_at", r.chi2_at}});
-            json sugg = json::array();
-            for (const auto& s : d.suggestions)
-              sugg.push_back({{"rig", s.rig},
-                              {"sample", s.sample},
-                              {"setting", s.setting},
-                              {"quantity", s.quantity},
-                              {"separation_sigma", s.separation},
-                              {"between", s.between}});
-            json out = {{"baseline", comparison_json(d.baseline)},
-                        {"baseline_bic", d.baseline_bic},
-                        {"baseline_p", d.baseline_p},
-                        {"candidates", cands},
-                        {"verdict",
-                         {{"effect", d.consistent ? json(nullptr) : json(d.verdict)},
-                          {"consistent", d.consistent},
-                          {"confidence", d.confidence}}},
-                        {"drivers", d.drivers},
-                        {"indistinguishable", d.indistinguishable},
-                        {"suggestions", sugg},
-                        {"skipped", d.skipped},
-                        {"simulations", d.simulations},
-                        {"summary", d.summary()}};
-            ReportInput rep;
-            rep.chain.emplace_back(base.name, d.baseline);
-            if (a->apply) {
-              if (d.consistent) {
-                std::cout << "--apply: nothing to add, the model is consistent with the data\n";
-              } else {
-                const CandidateResult& top = d.candidates.front();
-                ParticleModel next = top.candidate.apply(base, top.fitted);
-                next.name = base.name + "+" + top.candidate.effect;
-                write_file_atomic(a->output,
-                                  format_model(next, a->output,
-                                               fmt::format("{} with {} = {} added by clumpkit "
-                                                           "diagnose",
-                                                           base.name, top.candidate.parameter,
-                                                           top.candidate.format(top.fitted))));
-                out["applied"] = {{"effect", top.candidate.effect}, {"model", a->output}};
-                rep.chain.emplace_back(next.name, top.comparison);
-                std::cout << "wrote " << a->output << " (" << next.name << ")\n";
-              }
-            }
-            if (!a->json.empty()) write_json(out, a->json);
-            if (!a->report.empty()) {
-              rep.title = "clumpkit diagnose: " + base.name;
-              rep.diagnosis = &d;
-              rep.pictures = sim.pictures();
-              write_report(rep, a->report);
-              std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string()
-                        << "\n";
-            }
-            return 0;
-          }};
+  return {
+      c, [a] {
+        const auto ms = load_measurements(a->measurements);
+        warn_redundant(ms, a->measurements);
+        if (ms.size() < 3)
+          throw InputError(a->measurements, "",
+                           fmt::format("{} observable(s) are too few to tell effects apart "
+                                       "(need at least 3)",
+                                       ms.size()));
+        const ParticleModel base = load_model(find_model(a->models.front()), data_dir());
+        if (a->apply && a->output.empty())
+          throw InputError("", "--output", "--apply needs -o NEW_MODEL.toml");
+        if (!a->output.empty()) check_writable(a->output, "--output");
+        if (!a->report.empty()) {
+          std::error_code ec;
+          std::filesystem::create_directories(a->report, ec);
+        }
+        check_outputs(*a);
+        DiagnoseOptions o;
+        o.scale = a->scale;
+        o.repeats = a->repeats;
+        o.screen_repeats = a->screen_repeats;
+        o.seed = a->seed;
+        o.suggest = !a->no_suggest;
+        std::string list = a->effects;
+        for (size_t p; (p = list.find(',')) != std::string::npos; list.erase(0, p + 1))
+          if (p > 0) o.effects.push_back(list.substr(0, p));
+        if (!list.empty()) o.effects.push_back(list);
+        effect_candidates(base, o.effects, nullptr, "--effects");  // names checked up front
+        if (!a->quiet)
+          o.progress = [](const std::string& s) { std::cerr << "diagnose: " << s << "\n"; };
+        RigSimulator sim = make_sim(*a);
+        const Diagnosis d = diagnose(base, ms, sim, o);
+        std::cout << fmt::format(
+            "{:<18} {:<38} {:>14} {:>10} {:>22} {:>9} {:>9} {:>9} {:>7} {:<13} {}\n", "effect",
+            "parameter", "fitted", "+/-", "95 % interval", "chi2", "dchi2", "BIC", "weight",
+            "plausible", "chi2 from");
+        std::cout << fmt::format("{:<18} {:<38} {:>14} {:>10} {:>22} {:>9.2f} {:>9} {:>9.2f}\n",
+                                 "(baseline)", base.name, "", "", "", d.baseline.chi2, "",
+                                 d.baseline_bic);
+        for (const auto& r : d.candidates)
+          std::cout << fmt::format(
+              "{:<18} {:<38} {:>14} {:>10.3g} {:>22} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {:<13} "
+              "{}\n",
+              r.candidate.effect, r.candidate.parameter, r.candidate.format(r.fitted), r.fitted_std,
+              interval_text(r), r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
+              r.plausible  ? "yes"
+              : r.at_limit ? "no (at limit)"
+                           : "no (at bound)",
+              chi2_source_text(r));
+        for (const auto& r : d.candidates)
+          if (!r.limit.empty())
+            std::cout << "limit: " << r.candidate.effect << ": " << r.limit << "\n";
+        for (const auto& s : d.skipped) std::cout << "not tried: " << s << "\n";
+        std::cout << d.summary();
+        std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n", sim.runs(),
+                                 sim.cache_hits());
+        json cands = json::array();
+        for (const auto& r : d.candidates)
+          cands.push_back({{"effect", r.candidate.effect},
+                           {"parameter", r.candidate.parameter},
+                           {"unit", r.candidate.unit},
+                           {"fitted",
+                            {{"value", r.fitted},
+                             {"std", r.fitted_std},
+                             {"interval_95", {r.fitted_lo, r.fitted_hi}}}},
+                           {"range", {r.candidate.lo, r.candidate.hi}},
+                           {"chi2", r.comparison.chi2},
+                           {"chi2_per_dof", r.comparison.chi2_per_dof},
+                           {"delta_chi2", r.delta_chi2},
+                           {"bic", r.bic},
+                           {"weight", r.weight},
+                           {"plausible", r.plausible},
+                           {"at_bound", r.at_bound},
+                           {"limit", r.limit},
+                           {"at_limit", r.at_limit},
+                           {"chi2_source", r.chi2_source},
+                           {"chi2_at", r.chi2_at}});
+        json sugg = json::array();
+        for (const auto& s : d.suggestions)
+          sugg.push_back({{"rig", s.rig},
+                          {"sample", s.sample},
+                          {"setting", s.setting},
+                          {"quantity", s.quantity},
+                          {"separation_sigma", s.separation},
+                          {"between", s.between}});
+        json out = {{"baseline", comparison_json(d.baseline)},
+                    {"baseline_bic", d.baseline_bic},
+                    {"baseline_p", d.baseline_p},
+                    {"candidates", cands},
+                    {"verdict",
+                     {{"effect", d.consistent ? json(nullptr) : json(d.verdict)},
+                      {"consistent", d.consistent},
+                      {"confidence", d.confidence}}},
+                    {"drivers", d.drivers},
+                    {"indistinguishable", d.indistinguishable},
+                    {"suggestions", sugg},
+                    {"skipped", d.skipped},
+                    {"simulations", d.simulations},
+                    {"summary", d.summary()}};
+        ReportInput rep;
+        rep.chain.emplace_back(base.name, d.baseline);
+        if (a->apply) {
+          if (d.consistent) {
+            std::cout << "--apply: nothing to add, the model is consistent with the data\n";
+          } else {
+            const CandidateResult& top = d.candidates.front();
+            ParticleModel next = top.candidate.apply(base, top.fitted);
+            next.name = base.name + "+" + top.candidate.effect;
+            write_file_atomic(a->output,
+                              format_model(next, a->output,
+                                           fmt::format("{} with {} = {} added by clumpkit "
+                                                       "diagnose",
+                                                       base.name, top.candidate.parameter,
+                                                       top.candidate.format(top.fitted))));
+            out["applied"] = {{"effect", top.candidate.effect}, {"model", a->output}};
+            rep.chain.emplace_back(next.name, top.comparison);
+            std::cout << "wrote " << a->output << " (" << next.name << ")\n";
+          }
+        }
+        if (!a->json.empty()) write_json(out, a->json);
+        if (!a->report.empty()) {
+          rep.title = "clumpkit diagnose: " + base.name;
+          rep.diagnosis = &d;
+          rep.pictures = sim.pictures();
+          write_report(rep, a->report);
+          std::cout << "report: " << (std::filesystem::path(a->report) / "index.html").string()
+                    << "\n";
+        }
+        return 0;
+      }};
 }
 
 Command setup_synth(CLI::App& parent) {

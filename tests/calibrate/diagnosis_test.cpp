@@ -111,7 +111,7 @@ TEST(Diagnosis, FindsEachHiddenEffect) {
 // between its points trapped the fit at its extremum.
 TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
   const int trials = 40;
-  int covered = 0, first = 0;
+  int covered = 0, covered95 = 0, first = 0;
   for (int t = 0; t < trials; ++t) {
     fake::FakeSimulator sim;
     sim.noise_rel = 0.08;
@@ -147,10 +147,14 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
     first += top.candidate.effect == "rolling_friction";
     covered += top.candidate.effect == "rolling_friction" &&
                std::abs(top.fitted - 0.2) <= 2.0 * top.fitted_std;
+    covered95 +=
+        top.candidate.effect == "rolling_friction" && top.fitted_lo <= 0.2 && 0.2 <= top.fitted_hi;
   }
   EXPECT_EQ(first, trials);
   std::cout << "rolling friction ranked first in " << first << " of " << trials
-            << " trials, truth within 2 stated sigma in " << covered << "\n";
+            << " trials, truth within 2 stated sigma in " << covered
+            << ", within the 95 % interval in " << covered95 << "\n";
+  EXPECT_GE(covered95, 34) << covered95 << " of " << trials << " in the 95 % interval";
   // Nominal 2-sigma coverage is 95 % (38 of 40); measured 37 (38 before session 14's local
   // surrogate). With a two-repeat spread and an interpolating surrogate it was 19 of 40.
   EXPECT_GE(covered, 34) << covered << " of " << trials << " cover the truth";
@@ -262,7 +266,8 @@ TEST(Diagnosis, AFailedRunNarrowsTheRangeInsteadOfDroppingTheCandidate) {
 //   where the line misses them, up to 2 more steps for the leader): covered 11 (saturating)
 //   and 14 (accelerating) of 16, plausible 16 and 16, cohesion the verdict in all.
 // Where the response has levelled off the likelihood is skewed and the symmetric sigma short
-// on one side, so the coverage stays below the nominal 95 %.
+// on one side, so the coverage stays below the nominal 95 %; the reported 95 % interval (Delta
+// chi2 = 4 on the surrogate, asymmetric) covers the truth in 13 and 13 of 16.
 TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
   struct Shaped final : Simulator {
     std::function<double(double)> shape;  // cohesion -> the stand-in's (linear) cohesion
@@ -283,7 +288,7 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
       {"accelerating", [](double c) { return 1e4 * std::expm1(c / 1e4); }},
   };
   for (const auto& [name, shape] : shapes) {
-    int covered = 0, plausible = 0;
+    int covered = 0, covered95 = 0, plausible = 0;
     const int trials = 16;
     for (int t = 0; t < trials; ++t) {
       Shaped sim;
@@ -304,14 +309,23 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
       if (d.verdict != "cohesion") continue;
       const CandidateResult& top = d.candidates.front();
       const bool cov = std::abs(top.fitted - 20000.0) <= 2.0 * top.fitted_std;
+      const bool cov95 = top.fitted_lo <= 20000.0 && 20000.0 <= top.fitted_hi;
+      EXPECT_LE(top.fitted_lo, top.fitted);
+      EXPECT_GE(top.fitted_hi, top.fitted);
       const bool ok = chi2_survival(top.comparison.chi2, top.comparison.dof) >= 0.01;
       std::cout << name << " " << t << ": cohesion " << top.fitted << " +/- " << top.fitted_std
-                << " (" << top.chi2_source << "), chi2 " << top.comparison.chi2 << " on "
-                << top.comparison.dof << " dof\n";
+                << " [" << top.fitted_lo << ", " << top.fitted_hi << "] (" << top.chi2_source
+                << "), chi2 " << top.comparison.chi2 << " on " << top.comparison.dof << " dof\n";
       covered += cov;
+      covered95 += cov95;
       plausible += ok;
     }
+    std::cout << name << ": truth within 2 stated sigma in " << covered << ", within the 95 % "
+              << "interval in " << covered95 << " of " << trials << "\n";
     EXPECT_GE(covered, 9) << name;
+    // Measured: 13 and 13 of 16 (the 2-sigma counts 11 and 14: the interval gains where the
+    // response levels off and loses a grid step at the edge of a symmetric one).
+    EXPECT_GE(covered95, 12) << name;
     EXPECT_GE(plausible, trials - 1) << name;
   }
 }

@@ -280,6 +280,7 @@ double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& va
 
 struct Fit {
   double theta = 0, chi2 = 0, sigma = 0;
+  double lo95 = 0, hi95 = 0;  ///< Delta chi2 = 4 on the surrogate (asymmetric where it levels off)
 };
 
 Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
@@ -304,6 +305,10 @@ Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const 
   while (a > 0 && c[a] < f.chi2 + 1.0) --a;
   while (b < n && c[b] < f.chi2 + 1.0) ++b;
   f.sigma = 0.5 * (th[b] - th[a]);
+  while (a > 0 && c[a] < f.chi2 + 4.0) --a;
+  while (b < n && c[b] < f.chi2 + 4.0) ++b;
+  f.lo95 = th[a];
+  f.hi95 = th[b];
   return f;
 }
 
@@ -313,6 +318,11 @@ std::string observable_name(const Measurement& m) {
 }
 
 }  // namespace
+
+std::string interval_text(const CandidateResult& r) {
+  if (r.candidate.discrete) return "-";
+  return fmt::format("{:.3g} to {:.3g}", r.fitted_lo, r.fitted_hi);
+}
 
 std::string chi2_source_text(const CandidateResult& r) {
   if (r.chi2_source == "nearest_run") return "run at " + r.candidate.format(r.chi2_at);
@@ -668,6 +678,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     r.candidate = w.c;
     r.fitted = w.fit.theta;
     r.fitted_std = w.fit.sigma;
+    r.fitted_lo = w.c.discrete ? r.fitted : w.fit.lo95;
+    r.fitted_hi = w.c.discrete ? r.fitted : w.fit.hi95;
     // A surrogate's values keep the spread the fit gave them; a run's are pooled.
     r.comparison = compare(ms, w.source == "surrogate" ? w.at_fit : pool.pooled(w.at_fit), 1);
     r.chi2_source = w.source;
@@ -811,9 +823,9 @@ std::string Diagnosis::summary() const {
         confidence);
   } else {
     const CandidateResult& t = candidates.front();
-    s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}), confidence {:.2f}\n",
+    s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}{}), confidence {:.2f}\n",
                      verdict, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
-                     confidence);
+                     t.candidate.discrete ? "" : "; 95 %: " + interval_text(t), confidence);
     if (t.at_limit)
       s += "  warning: the fitted value is pinned at the edge of what the rigs could measure (" +
            t.limit + "): the strength may be larger than fitted\n";

@@ -210,15 +210,17 @@ std::string report_html(const ReportInput& in) {
     h += "<h2>Diagnosis</h2>\n<pre class=\"verdict\" id=\"verdict\">" +
          esc(in.diagnosis->summary()) + "</pre>\n";
     h += "<table id=\"candidates\"><tr><th>effect</th><th>parameter</th><th>fitted</th><th>&plusmn;"
-         "</th><th>chi2</th><th>&Delta;chi2</th><th>BIC</th><th>weight</th><th>plausible</th>"
+         "</th><th>95 % "
+         "interval</th><th>chi2</th><th>&Delta;chi2</th><th>BIC</th><th>weight</th><th>plausible</"
+         "th>"
          "<th>chi2 from</th></tr>\n";
     for (const auto& r : in.diagnosis->candidates)
       h += fmt::format(
-          "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.3g}</td>"
+          "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.3g}</td><td>{}</td>"
           "<td>{:.2f}</td><td>{:.2f}</td><td>{:.2f}</td><td>{:.3f}</td><td>{}</td>"
           "<td class=\"l\">{}</td></tr>\n",
           esc(r.candidate.effect), esc(r.candidate.parameter), esc(r.candidate.format(r.fitted)),
-          r.fitted_std, r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
+          r.fitted_std, esc(interval_text(r)), r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
           r.plausible  ? "yes"
           : r.at_limit ? "no (at limit)"
                        : "no",

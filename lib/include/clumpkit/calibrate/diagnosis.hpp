@@ -50,6 +50,10 @@ struct CandidateResult {
   EffectCandidate candidate;
   double fitted = 0.0;      ///< parameter value (candidate.unit)
   double fitted_std = 0.0;  ///< 1-sigma uncertainty from the fit's curvature (0: discrete)
+  /// The 95 % interval where chi2 on the response surrogate is within 4 of its minimum:
+  /// asymmetric where a response levels off (fitted_std, the Delta chi2 = 1 half-width, is then
+  /// short on the flat side); an open side reaches the fit's range. Discrete: both = fitted.
+  double fitted_lo = 0.0, fitted_hi = 0.0;
   Comparison comparison;    ///< against the data, at `chi2_at` (see chi2_source)
   /// How `comparison` was obtained: "run" (a simulation at `fitted`), "nearest_run" (the
   /// simulation at `chi2_at`, within a quarter of the fitted uncertainty of `fitted`: Delta chi2
@@ -95,6 +99,8 @@ Diagnosis diagnose(const ParticleModel& baseline, const std::vector<Measurement>
 
 /// Where a candidate's chi2 comes from, in words: "run", "run at <value>" or "surrogate".
 std::string chi2_source_text(const CandidateResult& r);
+/// "0.17 to 0.23" (the 95 % interval, in the parameter's unit), "-" for a discrete candidate.
+std::string interval_text(const CandidateResult& r);
 
 /// Survival function of the chi-square distribution, P(X >= x) with `dof` degrees of freedom.
 double chi2_survival(double x, int dof);
