@@ -42,7 +42,9 @@ void list_rigs() {
   }
   std::cout << "model effects (--set effects.NAME[.PARTNER]=VALUE|on|off):";
   for (const auto& e : effect_names()) std::cout << " " << e;
-  std::cout << "\n";
+  std::cout << "\n  e.g. effects.rolling_friction.pill=0.1, effects.cohesion=\"2e4 J/m^3\", "
+               "effects.shape_resolution=4, effects.size_distribution=0.05 (height spread), "
+               "effects.rolling_model=cdt, effects.restitution=off\n";
 }
 
 Command setup_rig(CLI::App& parent) {
