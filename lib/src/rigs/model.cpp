@@ -83,8 +83,8 @@ std::map<std::string, double> partner_values(const TomlDoc& doc, const std::stri
   return out;
 }
 
-// Effect tables are either `name = true` / `name = false` or a table `[effects.name]`.
-// A height spread splits paper-rule cylinders into height classes; "" when every type is one.
+// Why a height spread cannot split this model's types into height classes refilled by the paper
+// rule; "" when it can.
 std::string height_spread_blocker(const ParticleModel& m) {
   for (const ModelType& t : m.types) {
     if (t.shape.kind != ShapeSpec::Kind::Cylinder)
@@ -96,6 +96,7 @@ std::string height_spread_blocker(const ParticleModel& m) {
   return "";
 }
 
+// Effect tables are either `name = true` / `name = false` or a table `[effects.name]`.
 bool effect_listed(const TomlDoc& doc, const std::string& e, bool& as_table) {
   const std::string key = "effects." + e;
   as_table = false;
