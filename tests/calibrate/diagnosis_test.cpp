@@ -375,6 +375,46 @@ TEST(Diagnosis, AnEffectOnTheUnprobedSideOfTheBaselineIsFound) {
   }
 }
 
+// A discrete candidate's level is chosen on runs with every repeat, not on the one-repeat screen.
+// In the mini bench of session 15 (truth: the CDT rolling model, baseline the standard one) both
+// other models lowered the heap, the EPSD level screened better, only it was confirmed, and the
+// verdict named EPSD. Here the EPSD level's one screening run happens to match the data (its mean
+// over every repeat is 1.5 deg short of the truth's shift) and the CDT level's screening run is
+// 0.3 deg off (its mean matches): the verdict must be CDT. Before, it was EPSD.
+TEST(Diagnosis, ADiscreteLevelIsChosenOnRunsWithEveryRepeat) {
+  struct TwoModels final : Simulator {
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      ++runs_;
+      double shift = 0;  // deg on every heap angle
+      if (m.effects.rolling_model == dem::RollingModel::kCdt) shift = repeats == 1 ? -2.7 : -3.0;
+      if (m.effects.rolling_model == dem::RollingModel::kEpsd) shift = repeats == 1 ? -3.0 : -1.5;
+      ParticleModel s = m;
+      s.effects.rolling_model.reset();
+      SimValues v = inner.simulate(s, r, repeats, seed);
+      if (r.rig == "angle_of_repose")
+        for (auto& [q, x] : v) x.mean += shift;
+      return v;
+    }
+  };
+  TwoModels sim;
+  const ParticleModel base = base_model();  // the standard rolling model
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.rolling_model", "cdt", "test");
+  const auto ms = synthesize(sim, truth, 0.02, 77);
+  DiagnoseOptions o;
+  o.suggest = false;
+  o.effects = {"rolling_model"};
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  ASSERT_FALSE(d.consistent) << d.summary();
+  ASSERT_EQ(d.verdict, "rolling_model") << d.summary();
+  const CandidateResult& top = d.candidates.front();
+  EXPECT_EQ(top.fitted, static_cast<double>(static_cast<int>(dem::RollingModel::kCdt)))
+      << d.summary();
+  for (const auto& ob : top.comparison.observables) EXPECT_EQ(ob.simulated.n, 2);
+}
+
 TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {
   EXPECT_NEAR(chi2_survival(3.841, 1), 0.05, 1e-4);
   EXPECT_NEAR(chi2_survival(18.307, 10), 0.05, 1e-4);

@@ -346,7 +346,10 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   std::set<std::string> pooled_models;
   auto simulate = [&](const ParticleModel& m, int repeats) {
     Values v = simulate_measurements(sim, m, ms, o.scale, repeats, o.seed);
-    if (pooled_models.insert(model_fingerprint(m)).second) pool.add(v);
+    // Keyed by the repeats too: a screened level (one repeat, no spread) confirmed with every
+    // repeat adds its spread then.
+    if (pooled_models.insert(model_fingerprint(m) + "|" + std::to_string(repeats)).second)
+      pool.add(v);
     return v;
   };
   // Runs that are known in advance are announced together, so a simulator can run them side
@@ -408,6 +411,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     int failures = 0;
     int steps_left = 0;  ///< refinement steps still allowed
     int extra_left = 0;  ///< further steps while it leads and has not converged
+    /// Discrete: every level's runs (the screen's, replaced by a confirmation's).
+    std::vector<std::pair<double, Values>> level_runs;
   };
   std::vector<Work> work;
   // A failed run at theta: the rigs cannot measure there (a heap that spreads flat, or that the
@@ -474,6 +479,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
             w.at = c.levels[i];
             w.have_at_fit = true;
           }
+          w.level_runs.emplace_back(c.levels[i], std::move(v));
         }
       } else {
         say(fmt::format("{}: sensitivity at {} = {}", c.effect, c.parameter, c.format(c.probe)));
@@ -592,12 +598,16 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       best_real = std::min(best_real, compare(ms, pool.pooled(v), 1).chi2);
   }
   auto full = [&](const Values& v) { return !v.empty() && v.begin()->second.n >= o.repeats; };
-  std::vector<Work*> confirm;
+  std::vector<std::pair<Work*, double>> confirm;  // a candidate and the value to run it at
   for (Work& w : work) {
     if (w.dropped) continue;
     if (w.c.discrete) {
-      // A screened level that could lead is simulated again with every repeat.
-      if (!full(w.at_fit) && w.fit.chi2 < best_real + o.confirm_margin) confirm.push_back(&w);
+      // Every screened level that could lead is simulated again with every repeat: one
+      // repeat's noise must not choose between levels (the CDT and EPSD rolling models both
+      // lower a heap; the better-screened one is not always the better one).
+      for (const auto& [level, v] : w.level_runs)
+        if (!full(v) && compare(ms, pool.pooled(v), 1).chi2 < best_real + o.confirm_margin)
+          confirm.emplace_back(&w, level);
       continue;
     }
     if (w.have_at_fit) continue;
@@ -630,16 +640,29 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
                       "best run",
                       w.c.effect, w.c.format(w.fit.theta), w.fit.chi2, w.fit.chi2 - best_real));
     } else {
-      confirm.push_back(&w);
+      confirm.emplace_back(&w, w.fit.theta);
     }
   }
   {  // the confirmation runs, side by side
     std::vector<ParticleModel> models;
-    for (const Work* w : confirm) models.push_back(w->c.apply(base, w->fit.theta));
+    for (const auto& [w, value] : confirm) models.push_back(w->c.apply(base, value));
     prefetch(models, o.repeats);
   }
-  for (Work* w : confirm) {
-    say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(w->fit.theta)));
+  std::map<const Work*, std::string> level_failed;  // discrete: why a confirmed level failed
+  for (const auto& [w, value] : confirm) {
+    say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(value)));
+    if (w->c.discrete) {
+      for (auto& [level, v] : w->level_runs) {
+        if (level != value) continue;
+        try {
+          v = simulate(w->c.apply(base, level), o.repeats);
+        } catch (const NumericalError& e) {
+          level_failed[w] = "the run at " + w->c.format(level) + " failed: " + e.what();
+          v.clear();  // a level the rigs cannot measure is not chosen
+        }
+      }
+      continue;
+    }
     try {
       w->at_fit = simulate(w->c.apply(base, w->fit.theta), o.repeats);
     } catch (const NumericalError& e) {
@@ -664,9 +687,33 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         continue;
       }
     }
-    if (!w->c.discrete) w->s.add(w->fit.theta, w->at_fit);
+    w->s.add(w->fit.theta, w->at_fit);
     w->at = w->fit.theta;
     w->have_at_fit = true;
+  }
+  // A discrete candidate's level: the least chi2 among the levels run with every repeat (among
+  // the screened ones where none was confirmed); dropped where every confirmed level failed.
+  for (Work& w : work) {
+    if (w.dropped || !w.c.discrete) continue;
+    bool any_full = false;
+    for (const auto& p : w.level_runs) any_full = any_full || full(p.second);
+    if (!any_full && level_failed.count(&w)) {
+      d.skipped.push_back(w.c.effect + ": " + level_failed[&w]);
+      w.dropped = true;
+      continue;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& [level, v] : w.level_runs) {
+      if (v.empty() || (any_full && !full(v))) continue;
+      const double chi2 = compare(ms, pool.pooled(v), 1).chi2;
+      if (chi2 < best) {
+        best = chi2;
+        w.fit = {level, chi2, 0.0};
+        w.at_fit = v;
+        w.at = level;
+        w.have_at_fit = true;
+      }
+    }
   }
   // All runs are made: every comparison weighs by the final pooled spread.
   d.baseline = compare(ms, pool.pooled(s0), 0);
