@@ -375,6 +375,52 @@ TEST(Diagnosis, AnEffectOnTheUnprobedSideOfTheBaselineIsFound) {
   }
 }
 
+// An effect whose response sets in past the probe. In the mini bench of session 15 a restitution
+// of 0.7 (Table 1: 0.2-0.3) lowered the heaps by 5-7 deg; the probe at 0.5 had barely moved them,
+// the line through the baseline and the probe could not reach the data, restitution was neither
+// refined nor confirmed, and a lower rolling friction took the verdict with confidence 1.00.
+// Here restitution's effect on the heaps sets in at 0.45 and grows as the square; a lower
+// rolling friction and other candidates lower the heaps too. One screening run at twice the
+// probe's step shows restitution's effect, and it is fitted at the truth (0.749 +/- 0.003 for
+// 0.75, the verdict). Before, its surrogate stayed the line through 0.2 and 0.5, it was neither
+// refined nor confirmed, and rolling friction pinned at 0 was the verdict with confidence 1.00.
+TEST(Diagnosis, AnEffectThatSetsInPastTheProbeIsFound) {
+  struct LateRestitution final : Simulator {
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      ++runs_;
+      SimValues v = inner.simulate(m, r, repeats, seed);
+      const double e = m.effects.restitution ? m.effects.restitution->at("pill") : 1.0;
+      const double x = std::max(0.0, (e - 0.45) / 0.3);
+      for (auto& [q, val] : v) {
+        if (q.rfind("angle", 0) == 0) val.mean -= 6.0 * x * x;
+      }
+      return v;
+    }
+  };
+  LateRestitution sim;
+  const ParticleModel base = base_model();  // Table 1: e 0.2-0.3
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.restitution", "0.75", "test");
+  const auto ms = synthesize(sim, truth, 0.02, 31);
+  DiagnoseOptions o;
+  o.suggest = false;
+  o.effects = {"restitution",      "rolling_friction", "particle_friction",
+               "shape_resolution", "cohesion",         "wall_friction"};
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  ASSERT_FALSE(d.consistent) << d.summary();
+  const auto& named = d.indistinguishable;
+  EXPECT_TRUE(d.verdict == "restitution" ||
+              std::find(named.begin(), named.end(), "restitution") != named.end())
+      << d.summary();
+  for (const CandidateResult& r : d.candidates)
+    if (r.candidate.effect == "restitution") {
+      EXPECT_TRUE(r.plausible) << d.summary();
+      EXPECT_LE(std::abs(r.fitted - 0.75), 2.0 * r.fitted_std) << d.summary();
+    }
+}
+
 // A discrete candidate's level is chosen on runs with every repeat, not on the one-repeat screen.
 // In the mini bench of session 15 (truth: the CDT rolling model, baseline the standard one) both
 // other models lowered the heap, the EPSD level screened better, only it was confirmed, and the
