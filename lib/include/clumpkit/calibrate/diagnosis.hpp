@@ -33,7 +33,8 @@ struct DiagnoseOptions {
   int refinements = 2;               ///< real-run refinement steps for the leading candidates
   int refine_top = 3;                ///< how many leading candidates are refined
   /// Further steps for the candidate whose fit leads, while its fit still moves by more than a
-  /// quarter of its uncertainty (a response far from a parabola converges in more steps).
+  /// quarter of its uncertainty (a response far from a parabola converges in more steps); only
+  /// where the baseline is inconsistent with the data (p < p_inconsistent).
   int extra_refinements = 2;
   double min_delta_bic = 6.0;  ///< "strong" evidence (Kass & Raftery)
   double p_inconsistent = 0.01;
