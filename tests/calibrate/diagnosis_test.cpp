@@ -385,21 +385,13 @@ TEST(Diagnosis, AnEffectOnTheUnprobedSideOfTheBaselineIsFound) {
 // 0.75, the verdict). Before, its surrogate stayed the line through 0.2 and 0.5, it was neither
 // refined nor confirmed, and rolling friction pinned at 0 was the verdict with confidence 1.00.
 TEST(Diagnosis, AnEffectThatSetsInPastTheProbeIsFound) {
-  struct LateRestitution final : Simulator {
-    fake::FakeSimulator inner;
-    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
-                       std::uint64_t seed) override {
-      ++runs_;
-      SimValues v = inner.simulate(m, r, repeats, seed);
-      const double e = m.effects.restitution ? m.effects.restitution->at("pill") : 1.0;
-      const double x = std::max(0.0, (e - 0.45) / 0.3);
-      for (auto& [q, val] : v) {
-        if (q.rfind("angle", 0) == 0) val.mean -= 6.0 * x * x;
-      }
-      return v;
-    }
+  fake::Adjusted sim;
+  sim.adjust = [](const ParticleModel& m, const SimRequest&, int, SimValues& v) {
+    const double e = m.effects.restitution ? m.effects.restitution->at("pill") : 1.0;
+    const double x = std::max(0.0, (e - 0.45) / 0.3);
+    for (auto& [q, val] : v)
+      if (q.rfind("angle", 0) == 0) val.mean -= 6.0 * x * x;
   };
-  LateRestitution sim;
   const ParticleModel base = base_model();  // Table 1: e 0.2-0.3
   ParticleModel truth = base;
   set_model_effect(truth, "effects.restitution", "0.75", "test");
@@ -428,23 +420,15 @@ TEST(Diagnosis, AnEffectThatSetsInPastTheProbeIsFound) {
 // over every repeat is 1.5 deg short of the truth's shift) and the CDT level's screening run is
 // 0.3 deg off (its mean matches): the verdict must be CDT. Before, it was EPSD.
 TEST(Diagnosis, ADiscreteLevelIsChosenOnRunsWithEveryRepeat) {
-  struct TwoModels final : Simulator {
-    fake::FakeSimulator inner;
-    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
-                       std::uint64_t seed) override {
-      ++runs_;
-      double shift = 0;  // deg on every heap angle
-      if (m.effects.rolling_model == dem::RollingModel::kCdt) shift = repeats == 1 ? -2.7 : -3.0;
-      if (m.effects.rolling_model == dem::RollingModel::kEpsd) shift = repeats == 1 ? -3.0 : -1.5;
-      ParticleModel s = m;
-      s.effects.rolling_model.reset();
-      SimValues v = inner.simulate(s, r, repeats, seed);
-      if (r.rig == "angle_of_repose")
-        for (auto& [q, x] : v) x.mean += shift;
-      return v;
-    }
+  fake::Adjusted sim;
+  sim.strip = [](ParticleModel& m) { m.effects.rolling_model.reset(); };
+  sim.adjust = [](const ParticleModel& m, const SimRequest& r, int repeats, SimValues& v) {
+    double shift = 0;  // deg on every heap angle
+    if (m.effects.rolling_model == dem::RollingModel::kCdt) shift = repeats == 1 ? -2.7 : -3.0;
+    if (m.effects.rolling_model == dem::RollingModel::kEpsd) shift = repeats == 1 ? -3.0 : -1.5;
+    if (r.rig == "angle_of_repose")
+      for (auto& [q, x] : v) x.mean += shift;
   };
-  TwoModels sim;
   const ParticleModel base = base_model();  // the standard rolling model
   ParticleModel truth = base;
   set_model_effect(truth, "effects.rolling_model", "cdt", "test");

@@ -3,6 +3,7 @@
 // observables in its own direction (CALIBRATION.md's "fingerprints"), responses are nonlinear,
 // and every run carries seeded noise (common random numbers: the same seed gives the same noise).
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "clumpkit/calibrate/simulator.hpp"
@@ -65,6 +66,25 @@ class FakeSimulator final : public Simulator {
       out[q] = summarize(v);
     }
     return out;
+  }
+};
+
+// The stand-in with a test's own response added: `adjust` changes the values of a run of `model`
+// (the model as asked for, before `strip` takes from it what the stand-in must not see).
+class Adjusted final : public Simulator {
+ public:
+  FakeSimulator inner;
+  std::function<void(const ParticleModel&, const SimRequest&, int repeats, SimValues&)> adjust;
+  std::function<void(ParticleModel&)> strip = [](ParticleModel&) {};
+
+  SimValues simulate(const ParticleModel& model, const SimRequest& r, int repeats,
+                     std::uint64_t seed) override {
+    ++runs_;
+    ParticleModel m = model;
+    strip(m);
+    SimValues v = inner.simulate(m, r, repeats, seed);
+    adjust(model, r, repeats, v);
+    return v;
   }
 };
 

@@ -19,13 +19,19 @@ ParticleModel parse(const std::string& text) {
   return parse_model(text, kModels / "test_model.toml", fs::path(CLUMPKIT_SOURCE_DIR));
 }
 
-std::string error_of(const std::string& text) {
+// The InputError message of `f()`, "" if it throws none.
+template <class F>
+std::string error_from(F&& f) {
   try {
-    parse(text);
+    f();
   } catch (const InputError& e) {
     return e.what();
   }
   return "";
+}
+
+std::string error_of(const std::string& text) {
+  return error_from([&] { parse(text); });
 }
 
 const char* kHead = R"(
@@ -170,12 +176,7 @@ TEST(Model, AHeightSpreadIsSetFromTheCommandLineAndItsErrorsNameTheKey) {
   EXPECT_FALSE(m.effects.size_distribution);
   EXPECT_EQ(m.effects.height_spread, 0.0);
   auto set_error = [&](const std::string& key, const std::string& value) {
-    try {
-      set_model_effect(m, key, value, "--set");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
+    return error_from([&] { set_model_effect(m, key, value, "--set"); });
   };
   EXPECT_NE(set_error("effects.size_distribution", "0.5").find("0.3"), std::string::npos);
   EXPECT_NE(set_error("effects.size_distribution", "-0.1").find("size_distribution"),

@@ -512,29 +512,37 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // before the candidates are ranked.
   const bool inconsistent =
       chi2_survival(compare(ms, pool.pooled(s0), 0).chi2, n) < o.p_inconsistent;
-  if (inconsistent) {
-    std::vector<std::pair<Work*, double>> mirrors;
-    for (Work& w : work) {
-      if (w.c.discrete || w.s.points.size() != 2) continue;
-      const double probe =
-          w.s.points[0].first == w.c.baseline ? w.s.points[1].first : w.s.points[0].first;
-      if ((probe - w.c.baseline) * (w.fit.theta - w.c.baseline) >= 0.0) continue;
-      const double m = std::clamp(2.0 * w.c.baseline - probe, w.lo_ok, w.hi_ok);
-      if (m != w.c.baseline) mirrors.emplace_back(&w, m);
-    }
+  // One more screening run for each (candidate, value), side by side, and a refit.
+  auto screen_more = [&](const std::vector<std::pair<Work*, double>>& runs, const char* where) {
     std::vector<ParticleModel> models;
-    for (const auto& [w, m] : mirrors) models.push_back(w->c.apply(base, m));
+    for (const auto& [w, v] : runs) models.push_back(w->c.apply(base, v));
     prefetch(models, screen);
-    for (auto& [w, m] : mirrors) {
-      say(fmt::format("{}: sensitivity on the other side, at {} = {}", w->c.effect, w->c.parameter,
-                      w->c.format(m)));
+    for (const auto& [w, v] : runs) {
+      say(fmt::format("{}: sensitivity {}, at {} = {}", w->c.effect, where, w->c.parameter,
+                      w->c.format(v)));
       try {
-        w->s.add(m, simulate(w->c.apply(base, m), screen));
+        w->s.add(v, simulate(w->c.apply(base, v), screen));
       } catch (const NumericalError& e) {
-        cannot_measure(*w, m, e.what());
+        cannot_measure(*w, v, e.what());
       }
       w->fit = refit(*w);
     }
+  };
+  // The probe of a continuous candidate that has only its screen (baseline and probe), or NaN.
+  auto probe_of = [](const Work& w) {
+    if (w.c.discrete || w.s.points.size() != 2) return std::numeric_limits<double>::quiet_NaN();
+    return w.s.points[0].first == w.c.baseline ? w.s.points[1].first : w.s.points[0].first;
+  };
+  if (inconsistent) {
+    std::vector<std::pair<Work*, double>> mirrors;
+    for (Work& w : work) {
+      const double probe = probe_of(w);
+      if (std::isnan(probe) || (probe - w.c.baseline) * (w.fit.theta - w.c.baseline) >= 0.0)
+        continue;
+      const double m = std::clamp(2.0 * w.c.baseline - probe, w.lo_ok, w.hi_ok);
+      if (m != w.c.baseline) mirrors.emplace_back(&w, m);
+    }
+    screen_more(mirrors, "on the other side");
     // Beyond the probe. A response can stay flat up to the probe and set in past it (the heap
     // barely feels restitution from Table 1's 0.2 to 0.5 and a lot at 0.7): a candidate whose
     // line through the baseline and the probe points past the probe, removes part of the misfit
@@ -544,30 +552,16 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     std::vector<std::pair<Work*, double>> further;
     const Values pooled = pool.pooled(s0);
     for (Work& w : work) {
-      if (w.c.discrete || w.s.points.size() != 2) continue;
-      const double probe =
-          w.s.points[0].first == w.c.baseline ? w.s.points[1].first : w.s.points[0].first;
+      const double probe = probe_of(w);
       const double step = probe - w.c.baseline;
-      if ((w.fit.theta - probe) * step <= 0.0) continue;  // not past the probe
+      if (std::isnan(probe) || (w.fit.theta - probe) * step <= 0.0) continue;  // not past it
       const std::vector<double> var = fit_variances(ms, pooled, w.s);
       if (chi2_of(ms, var, w.s, w.c.baseline) - w.fit.chi2 < 4.0) continue;
       if (chi2_survival(w.fit.chi2, n) >= o.p_inconsistent) continue;  // explains the data
       const double f = std::clamp(w.c.baseline + 2.0 * step, w.lo_ok, w.hi_ok);
       if (f != probe) further.emplace_back(&w, f);
     }
-    models.clear();
-    for (const auto& [w, f] : further) models.push_back(w->c.apply(base, f));
-    prefetch(models, screen);
-    for (auto& [w, f] : further) {
-      say(fmt::format("{}: sensitivity further on, at {} = {}", w->c.effect, w->c.parameter,
-                      w->c.format(f)));
-      try {
-        w->s.add(f, simulate(w->c.apply(base, f), screen));
-      } catch (const NumericalError& e) {
-        cannot_measure(*w, f, e.what());
-      }
-      w->fit = refit(*w);
-    }
+    screen_more(further, "further on");
   }
   // Refine the leading continuous candidates with real runs at their fitted values.
   std::vector<size_t> order(work.size());

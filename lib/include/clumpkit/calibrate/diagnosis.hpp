@@ -55,7 +55,7 @@ struct CandidateResult {
   /// asymmetric where a response levels off (fitted_std, the Delta chi2 = 1 half-width, is then
   /// short on the flat side); an open side reaches the fit's range. Discrete: both = fitted.
   double fitted_lo = 0.0, fitted_hi = 0.0;
-  Comparison comparison;    ///< against the data, at `chi2_at` (see chi2_source)
+  Comparison comparison;  ///< against the data, at `chi2_at` (see chi2_source)
   /// How `comparison` was obtained: "run" (a simulation at `fitted`), "nearest_run" (the
   /// simulation at `chi2_at`, within a quarter of the fitted uncertainty of `fitted`: Delta chi2
   /// below ~0.06 by the fit's own curvature) or "surrogate" (no run: the response surrogate
