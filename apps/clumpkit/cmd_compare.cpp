@@ -28,6 +28,7 @@ struct CalArgs {
   int repeats = 2, threads = 0, jobs = 0, screen_repeats = 1;
   std::uint64_t seed = 1;
   bool apply = false, quiet = false, no_suggest = false;
+  std::string suggest = "ambiguous";
   double noise = 0.03;
 };
 
@@ -196,9 +197,13 @@ Command setup_diagnose(CLI::App& parent) {
   c->add_option("--report", a->report, "Write a self-contained HTML report into this folder");
   c->add_flag("--apply", a->apply, "Write the model with the winning effect at its fitted value");
   c->add_option("-o,--output", a->output, "With --apply: the new model file (.toml)");
-  c->add_flag("--no-suggest", a->no_suggest,
-              "Skip simulating unmeasured settings for the "
-              "next-measurement suggestion");
+  c->add_option("--suggest", a->suggest,
+                "When to simulate unmeasured settings for the next-measurement suggestion: "
+                "ambiguous (a verdict with an indistinguishable effect or a confidence below "
+                "0.9), always, or never")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"ambiguous", "always", "never"}));
+  c->add_flag("--no-suggest", a->no_suggest, "The same as --suggest never");
   c->add_option("--screen-repeats", a->screen_repeats,
                 "Repeats of the first phase's probes and discrete levels (a screen; the "
                 "leaders get --repeats when refined). Set it to --repeats for a full first "
@@ -229,7 +234,8 @@ Command setup_diagnose(CLI::App& parent) {
         o.repeats = a->repeats;
         o.screen_repeats = a->screen_repeats;
         o.seed = a->seed;
-        o.suggest = !a->no_suggest;
+        o.suggest = !a->no_suggest && a->suggest != "never";
+        o.suggest_always = a->suggest == "always";
         std::string list = a->effects;
         for (size_t p; (p = list.find(',')) != std::string::npos; list.erase(0, p + 1))
           if (p > 0) o.effects.push_back(list.substr(0, p));
@@ -303,6 +309,7 @@ Command setup_diagnose(CLI::App& parent) {
                     {"drivers", d.drivers},
                     {"indistinguishable", d.indistinguishable},
                     {"suggestions", sugg},
+                    {"suggestion_note", d.suggestion_note},
                     {"skipped", d.skipped},
                     {"simulations", d.simulations},
                     {"summary", d.summary()}};

@@ -22,20 +22,22 @@ ParticleModel base_model() {
   return m;
 }
 
+// The stand-in's measurement template: three cups, two plates, three wheel speeds.
+const char* const kTemplate =
+    "rig,sample,setting,quantity,value,std,n,unit\n"
+    "bulk_density,A,wall=organic_glass,bulk_density,1,1,3,kg/m^3\n"
+    "bulk_density,A,wall=galvanized_steel,bulk_density,1,1,3,kg/m^3\n"
+    "bulk_density,A,wall=abs_plastic,bulk_density,1,1,3,kg/m^3\n"
+    "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
+    "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
+    "discharge,A,rpm=10,pocket_mass,1,1,3,kg\n"
+    "discharge,A,rpm=15,pocket_mass,1,1,3,kg\n"
+    "discharge,A,rpm=30,pocket_mass,1,1,3,kg\n";
+
 // Measurements from a truth model: the template's rows, values = simulation with a seed the
 // diagnosis never uses, plus lab noise of relative size `rel`.
 std::vector<Measurement> synthesize(Simulator& sim, const ParticleModel& truth, double rel,
-                                    std::uint64_t seed) {
-  const std::string csv =
-      "rig,sample,setting,quantity,value,std,n,unit\n"
-      "bulk_density,A,wall=organic_glass,bulk_density,1,1,3,kg/m^3\n"
-      "bulk_density,A,wall=galvanized_steel,bulk_density,1,1,3,kg/m^3\n"
-      "bulk_density,A,wall=abs_plastic,bulk_density,1,1,3,kg/m^3\n"
-      "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
-      "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
-      "discharge,A,rpm=10,pocket_mass,1,1,3,kg\n"
-      "discharge,A,rpm=15,pocket_mass,1,1,3,kg\n"
-      "discharge,A,rpm=30,pocket_mass,1,1,3,kg\n";
+                                    std::uint64_t seed, const std::string& csv = kTemplate) {
   auto ms = parse_measurements(csv, "template.csv");
   auto sims = simulate_measurements(sim, truth, ms, "mini", 3, seed);
   std::mt19937_64 rng(seed);
@@ -77,7 +79,7 @@ TEST(Diagnosis, FindsEachHiddenEffect) {
     set_model_effect(truth, h.key, h.value, "test");
     const auto ms = synthesize(sim, truth, 0.02, seed);
     DiagnoseOptions o;
-    o.suggest = true;
+    o.suggest_always = true;  // the suggestion's machinery on every case
     o.suggest_max = 2;
     const Diagnosis d = diagnose(base, ms, sim, o);
     ASSERT_FALSE(d.consistent) << h.effect << "\n" << d.summary();
@@ -506,6 +508,7 @@ TEST(Diagnosis, SuggestsOnlyExperimentalSettings) {
   DiagnoseOptions o;
   o.effects = {"rolling_friction", "cohesion"};
   o.suggest_max = 100;
+  o.suggest_always = true;
   const Diagnosis d = diagnose(base, ms, sim, o);
   ASSERT_FALSE(d.suggestions.empty());
   std::set<std::string> settings;
@@ -517,4 +520,60 @@ TEST(Diagnosis, SuggestsOnlyExperimentalSettings) {
   }
   EXPECT_TRUE(settings.count("angle_of_repose plate=abs_plastic")) << d.summary();
   EXPECT_TRUE(settings.count("discharge rpm=15")) << d.summary();
+}
+
+// The suggestion's runs are made only where a measurement is needed: not when the model is
+// consistent with the data, nor for a decisive verdict (each says why in the summary), but when
+// two effects explain the data alike.
+TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
+  ParticleModel base = base_model();
+  set_model_effect(base, "effects.rolling_friction", "off", "test");
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
+  DiagnoseOptions o;
+  o.effects = {"rolling_friction", "cohesion", "particle_friction"};
+  {
+    // Decisive: the whole template separates rolling friction from cohesion.
+    fake::FakeSimulator sim;
+    const auto ms = synthesize(sim, truth, 0.02, 17);
+    const Diagnosis d = diagnose(base, ms, sim, o);
+    ASSERT_EQ(d.verdict, "rolling_friction") << d.summary();
+    ASSERT_TRUE(d.indistinguishable.empty()) << d.summary();
+    EXPECT_TRUE(d.suggestions.empty());
+    EXPECT_NE(d.suggestion_note.find("decisive"), std::string::npos) << d.suggestion_note;
+    EXPECT_NE(d.summary().find("next measurement: none needed"), std::string::npos);
+    DiagnoseOptions always = o;
+    always.suggest_always = true;
+    fake::FakeSimulator sim2;
+    const Diagnosis d2 = diagnose(base, ms, sim2, always);
+    EXPECT_EQ(d2.verdict, d.verdict);
+    EXPECT_FALSE(d2.suggestions.empty());
+    EXPECT_GT(d2.simulations, d.simulations);
+  }
+  {
+    // Consistent: nothing is hidden.
+    fake::FakeSimulator sim;
+    const auto ms = synthesize(sim, base, 0.02, 18);
+    const Diagnosis d = diagnose(base, ms, sim, o);
+    ASSERT_TRUE(d.consistent) << d.summary();
+    EXPECT_TRUE(d.suggestions.empty());
+    EXPECT_NE(d.suggestion_note.find("consistent"), std::string::npos) << d.suggestion_note;
+  }
+  {
+    // Ambiguous: heap angles alone, which rolling friction and cohesion raise alike.
+    const std::string heaps =
+        "rig,sample,setting,quantity,value,std,n,unit\n"
+        "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
+        "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
+        "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n";
+    fake::FakeSimulator sim;
+    const auto ms = synthesize(sim, truth, 0.02, 19, heaps);
+    DiagnoseOptions two = o;
+    two.effects = {"rolling_friction", "cohesion"};
+    const Diagnosis d = diagnose(base, ms, sim, two);
+    ASSERT_FALSE(d.consistent) << d.summary();
+    ASSERT_FALSE(d.indistinguishable.empty()) << d.summary();
+    EXPECT_FALSE(d.suggestions.empty()) << d.summary();
+    EXPECT_TRUE(d.suggestion_note.empty()) << d.suggestion_note;
+  }
 }

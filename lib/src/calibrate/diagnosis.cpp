@@ -812,8 +812,25 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     }
   }
 
-  // Which unmeasured rig setting would best separate the two leading explanations?
-  if (o.suggest && d.candidates.size() >= 2 && o.suggest_max > 0) {
+  // Which unmeasured rig setting would best separate the two leading explanations? Only asked
+  // where the answer is needed (DiagnoseOptions::suggest_always).
+  bool suggest = o.suggest && d.candidates.size() >= 2 && o.suggest_max > 0;
+  if (!o.suggest || o.suggest_max <= 0) {
+    d.suggestion_note = "not simulated (switched off)";
+  } else if (d.candidates.size() < 2) {
+    d.suggestion_note = "not simulated: fewer than two candidates to tell apart";
+  } else if (!o.suggest_always && d.consistent) {
+    suggest = false;
+    d.suggestion_note =
+        "none needed: the model is consistent with the data (--suggest always simulates one)";
+  } else if (!o.suggest_always && d.indistinguishable.empty() && d.confidence >= o.suggest_below) {
+    suggest = false;
+    d.suggestion_note = fmt::format(
+        "none needed: the verdict is decisive (confidence {:.2f}, no other effect within 2 BIC "
+        "units; --suggest always simulates one)",
+        d.confidence);
+  }
+  if (suggest) {
     const CandidateResult& a = d.candidates[0];
     const CandidateResult& b = d.candidates[1];
     const ParticleModel ma = a.candidate.apply(base, a.fitted);
@@ -886,6 +903,9 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     }
     std::sort(d.suggestions.begin(), d.suggestions.end(),
               [](const Suggestion& x, const Suggestion& y) { return x.separation > y.separation; });
+    if (d.suggestions.empty())
+      d.suggestion_note = trial.empty() ? "none: every experimental setting is measured already"
+                                        : "none: no unmeasured setting could be simulated";
   }
   d.simulations = sim.runs() - runs0;
   return d;
@@ -923,6 +943,8 @@ std::string Diagnosis::summary() const {
     s += fmt::format("next measurement: {} sample {}{} {} separates {} by {:.1f} sigma\n", g.rig,
                      g.sample, g.setting.empty() ? "" : " [" + g.setting + "]", g.quantity,
                      g.between, g.separation);
+  } else if (!suggestion_note.empty()) {
+    s += "next measurement: " + suggestion_note + "\n";
   }
   return s;
 }

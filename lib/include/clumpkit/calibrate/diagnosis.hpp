@@ -43,7 +43,13 @@ struct DiagnoseOptions {
   /// surrogate's (CandidateResult::chi2_source). 25 is a BIC weight below e^-12 of the leader's.
   double confirm_margin = 25.0;
   bool suggest = true;  ///< simulate unmeasured settings to suggest a measurement
-  int suggest_max = 4;  ///< at most this many settings tried
+  /// Simulate them even when no measurement is needed: the model is consistent with the data,
+  /// or the verdict is decisive (confidence >= suggest_below and no effect indistinguishable).
+  /// The suggestion's runs (each trial setting for both leading models, with every repeat)
+  /// cost as much as a candidate's screening and confirmation together.
+  bool suggest_always = false;
+  double suggest_below = 0.9;  ///< a verdict less confident than this gets a suggestion
+  int suggest_max = 4;         ///< at most this many settings tried
   std::function<void(const std::string&)> progress;
 };
 
@@ -91,8 +97,9 @@ struct Diagnosis {
   std::vector<std::string> drivers;  ///< observables that drive the verdict
   std::vector<std::string> indistinguishable;  ///< effects within 2 BIC units of the best
   std::vector<Suggestion> suggestions;         ///< best first
-  long simulations = 0;                        ///< rig runs made (not served by the cache)
-  std::string summary() const;                 ///< the verdict in words
+  std::string suggestion_note;  ///< why no measurement was suggested (empty when one was)
+  long simulations = 0;         ///< rig runs made (not served by the cache)
+  std::string summary() const;  ///< the verdict in words
 };
 
 Diagnosis diagnose(const ParticleModel& baseline, const std::vector<Measurement>& measurements,
