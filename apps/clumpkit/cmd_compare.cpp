@@ -27,7 +27,7 @@ struct CalArgs {
   std::string effects;
   int repeats = 2, threads = 0, jobs = 0, screen_repeats = 1;
   std::uint64_t seed = 1;
-  bool apply = false, quiet = false, no_suggest = false;
+  bool apply = false, quiet = false, no_suggest = false, no_pairs = false;
   std::string suggest = "ambiguous";
   double noise = 0.03;
 };
@@ -204,6 +204,9 @@ Command setup_diagnose(CLI::App& parent) {
       ->capture_default_str()
       ->check(CLI::IsMember({"ambiguous", "always", "never"}));
   c->add_flag("--no-suggest", a->no_suggest, "The same as --suggest never");
+  c->add_flag("--no-pairs", a->no_pairs,
+              "Never fit two effects at once (by default a pair is tried where no single effect "
+              "explains the data)");
   c->add_option("--screen-repeats", a->screen_repeats,
                 "Repeats of the first phase's probes and discrete levels (a screen; the "
                 "leaders get --repeats when refined). Set it to --repeats for a full first "
@@ -236,6 +239,7 @@ Command setup_diagnose(CLI::App& parent) {
         o.seed = a->seed;
         o.suggest = !a->no_suggest && a->suggest != "never";
         o.suggest_always = a->suggest == "always";
+        o.pairs = !a->no_pairs;
         std::string list = a->effects;
         for (size_t p; (p = list.find(',')) != std::string::npos; list.erase(0, p + 1))
           if (p > 0) o.effects.push_back(list.substr(0, p));
@@ -270,7 +274,17 @@ Command setup_diagnose(CLI::App& parent) {
         std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n", sim.runs(),
                                  sim.cache_hits());
         json cands = json::array();
-        for (const auto& r : d.candidates)
+        for (const auto& r : d.candidates) {
+          json with = nullptr;  // the second effect of a pair
+          if (!r.with_effect.empty())
+            with = {{"effect", r.with_effect},
+                    {"parameter", r.with_candidate.parameter},
+                    {"unit", r.with_candidate.unit},
+                    {"fitted",
+                     {{"value", r.with_fitted},
+                      {"std", r.with_std},
+                      {"interval_95", {r.with_lo, r.with_hi}}}},
+                    {"range", {r.with_candidate.lo, r.with_candidate.hi}}};
           cands.push_back({{"effect", r.candidate.effect},
                            {"parameter", r.candidate.parameter},
                            {"unit", r.candidate.unit},
@@ -289,7 +303,9 @@ Command setup_diagnose(CLI::App& parent) {
                            {"limit", r.limit},
                            {"at_limit", r.at_limit},
                            {"chi2_source", r.chi2_source},
-                           {"chi2_at", r.chi2_at}});
+                           {"chi2_at", r.chi2_at},
+                           {"with", with}});
+        }
         json sugg = json::array();
         for (const auto& s : d.suggestions)
           sugg.push_back({{"rig", s.rig},

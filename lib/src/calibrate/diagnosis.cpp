@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
+#include <tuple>
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/rigs/catalogue.hpp"
@@ -309,6 +311,76 @@ Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const 
   while (b < n && c[b] < f.chi2 + 4.0) ++b;
   f.lo95 = th[a];
   f.hi95 = th[b];
+  return f;
+}
+
+// Two continuous candidates at once, on the sum of their one-effect surrogates: the responses
+// to a and to b add (each surrogate's change from its own baseline), plus `offset`, what a run
+// of the pair showed the sum to miss (the interaction). chi2 on a grid over both ranges; each
+// parameter's uncertainty from its profile (the least chi2 over the other).
+struct PairFitResult {
+  double ta = 0, tb = 0, chi2 = std::numeric_limits<double>::infinity();
+  double sa = 0, sb = 0, lo_a = 0, hi_a = 0, lo_b = 0, hi_b = 0;
+};
+
+PairFitResult fit_pair(const std::vector<Measurement>& ms, const Values& pooled, const Surrogate& a,
+                       double base_a, std::pair<double, double> range_a, const Surrogate& b,
+                       double base_b, std::pair<double, double> range_b,
+                       const std::vector<double>& offset) {
+  constexpr int kGrid = 160;
+  const size_t n = ms.size();
+  const std::vector<double> va = fit_variances(ms, pooled, a), vb = fit_variances(ms, pooled, b);
+  std::vector<double> var(n);
+  for (size_t k = 0; k < n; ++k) var[k] = va[k] + vb[k] - ms[k].std * ms[k].std / ms[k].n;
+  auto axis = [](std::pair<double, double> r, int i) {
+    return r.first + (r.second - r.first) * i / kGrid;
+  };
+  // Each surrogate's change from its baseline, on its grid.
+  std::vector<double> da((kGrid + 1) * n), db((kGrid + 1) * n);
+  for (size_t k = 0; k < n; ++k) {
+    const std::string key = ms[k].key();
+    const double a0 = a.value(key, base_a), b0 = b.value(key, base_b);
+    for (int i = 0; i <= kGrid; ++i) {
+      da[i * n + k] = a.value(key, axis(range_a, i)) - a0;
+      db[i * n + k] = b.value(key, axis(range_b, i)) - b0;
+    }
+  }
+  // The residual at the baselines: the baseline's mean (a's surrogate there) against the data.
+  std::vector<double> r0(n);
+  for (size_t k = 0; k < n; ++k) r0[k] = a.value(ms[k].key(), base_a) + offset[k] - ms[k].value;
+  std::vector<double> chi2((kGrid + 1) * (kGrid + 1));
+  PairFitResult f;
+  int bi = 0, bj = 0;
+  for (int i = 0; i <= kGrid; ++i)
+    for (int j = 0; j <= kGrid; ++j) {
+      double c = 0;
+      for (size_t k = 0; k < n; ++k) {
+        const double d = r0[k] + da[i * n + k] + db[j * n + k];
+        c += d * d / var[k];
+      }
+      chi2[i * (kGrid + 1) + j] = c;
+      if (c < f.chi2) f.chi2 = c, bi = i, bj = j;
+    }
+  f.ta = axis(range_a, bi);
+  f.tb = axis(range_b, bj);
+  std::vector<double> pa(kGrid + 1, std::numeric_limits<double>::infinity()), pb = pa;
+  for (int i = 0; i <= kGrid; ++i)
+    for (int j = 0; j <= kGrid; ++j) {
+      pa[i] = std::min(pa[i], chi2[i * (kGrid + 1) + j]);
+      pb[j] = std::min(pb[j], chi2[i * (kGrid + 1) + j]);
+    }
+  auto interval = [&](const std::vector<double>& prof, int best, std::pair<double, double> r,
+                      double up) {
+    int lo = best, hi = best;
+    while (lo > 0 && prof[lo] < f.chi2 + up) --lo;
+    while (hi < kGrid && prof[hi] < f.chi2 + up) ++hi;
+    return std::pair<double, double>{axis(r, lo), axis(r, hi)};
+  };
+  const auto a1 = interval(pa, bi, range_a, 1.0), b1 = interval(pb, bj, range_b, 1.0);
+  f.sa = 0.5 * (a1.second - a1.first);
+  f.sb = 0.5 * (b1.second - b1.first);
+  std::tie(f.lo_a, f.hi_a) = interval(pa, bi, range_a, 4.0);
+  std::tie(f.lo_b, f.hi_b) = interval(pb, bj, range_b, 4.0);
   return f;
 }
 
@@ -747,6 +819,106 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       }
     }
   }
+  // Two effects at once. Where even the best single effect leaves the data unexplained (its
+  // run's chi2 has p < p_inconsistent), two effects may be missing: one alone is fitted too
+  // far (a hidden rolling friction and cohesion both raise the heap; cohesion alone, fitted to
+  // the heaps, then lowers the cup too much), and the next diagnosis cannot add the other,
+  // since the heaps already match. Every pair of continuous candidates is fitted on the sum of
+  // their surrogates (no runs); the best pair, if it beats the best single effect by
+  // min_delta_bic with its second parameter paid for, is run at its fit (every repeat), and
+  // once more where that run moves the fit (the sum's miss at the run added as an offset).
+  struct PairWork {
+    Work* a = nullptr;
+    Work* b = nullptr;
+    PairFitResult fit;
+    Values at_fit;
+  };
+  std::vector<PairWork> pairs;
+  if (inconsistent && o.pairs && o.pair_top > 0 && n >= o.pair_min_observables) {
+    const Values pooled = pool.pooled(s0);
+    double best_single = std::numeric_limits<double>::infinity();
+    for (const Work& w : work)
+      if (!w.dropped && w.have_at_fit && w.source != "surrogate")
+        best_single = std::min(best_single, compare(ms, pool.pooled(w.at_fit), 1).chi2);
+    if (std::isfinite(best_single) && chi2_survival(best_single, n) < o.p_inconsistent) {
+      const std::vector<double> no_offset(ms.size(), 0.0);
+      auto fit_of = [&](PairWork& p, const std::vector<double>& offset) {
+        p.fit = fit_pair(ms, pool.pooled(s0), p.a->s, p.a->c.baseline, fit_range(*p.a), p.b->s,
+                         p.b->c.baseline, fit_range(*p.b), offset);
+      };
+      std::vector<PairWork> all;
+      for (Work& a : work)
+        for (Work& b : work) {
+          if (&a == &b || a.dropped || b.dropped || a.c.discrete || b.c.discrete) continue;
+          // The single effect that explains more goes first (its parameter is `fitted`).
+          if (b.fit.chi2 < a.fit.chi2 || (b.fit.chi2 == a.fit.chi2 && &b < &a)) continue;
+          PairWork p{&a, &b, {}, {}};
+          fit_of(p, no_offset);
+          // Run only a pair that would beat the best single effect decisively (its second
+          // parameter paid for).
+          if (p.fit.chi2 + 2.0 * ln_n + o.min_delta_bic <= best_single + ln_n) all.push_back(p);
+        }
+      std::sort(all.begin(), all.end(),
+                [](const PairWork& x, const PairWork& y) { return x.fit.chi2 < y.fit.chi2; });
+      if (static_cast<int>(all.size()) > o.pair_top) all.resize(o.pair_top);
+      if (!all.empty())
+        say(
+            fmt::format("no single effect explains the data (best chi2 {:.1f}); {} pair(s) of "
+                        "effects might (best: {} + {}, chi2 {:.1f} on the sum of their responses)",
+                        best_single, all.size(), all.front().a->c.effect, all.front().b->c.effect,
+                        all.front().fit.chi2));
+      auto model_of = [&](const PairWork& p) {
+        return p.b->c.apply(p.a->c.apply(base, p.fit.ta), p.fit.tb);
+      };
+      // Each pair is run at its fit, and once more where the run moves the fit (the sum's miss
+      // at the run added to it as an offset); it stands where it was last run.
+      std::vector<PairWork*> going;
+      for (PairWork& p : all) going.push_back(&p);
+      std::map<PairWork*, std::vector<double>> offsets;
+      std::map<PairWork*, std::pair<double, double>> ran;
+      for (int run = 0; run < o.pair_runs && !going.empty(); ++run) {
+        std::vector<ParticleModel> models;
+        for (PairWork* p : going) models.push_back(model_of(*p));
+        prefetch(models, o.repeats);
+        std::vector<PairWork*> still;
+        for (PairWork* p : going) {
+          say(fmt::format("{} + {}: confirming at {} and {}", p->a->c.effect, p->b->c.effect,
+                          p->a->c.format(p->fit.ta), p->b->c.format(p->fit.tb)));
+          Values v;
+          try {
+            v = simulate(model_of(*p), o.repeats);
+          } catch (const NumericalError& e) {
+            say(fmt::format("{} + {}: the run failed: {}", p->a->c.effect, p->b->c.effect,
+                            e.what()));
+            if (ran.count(p)) std::tie(p->fit.ta, p->fit.tb) = ran[p];
+            continue;
+          }
+          p->at_fit = v;
+          const double ta = p->fit.ta, tb = p->fit.tb;
+          ran[p] = {ta, tb};
+          std::vector<double>& offset = offsets[p];
+          offset.assign(ms.size(), 0.0);
+          for (size_t k = 0; k < ms.size(); ++k) {
+            const std::string key = ms[k].key();
+            offset[k] = v.at(key).mean - (p->a->s.value(key, ta) + p->b->s.value(key, tb) -
+                                          p->b->s.value(key, p->b->c.baseline));
+          }
+          fit_of(*p, offset);
+          const bool moved = std::abs(p->fit.ta - ta) > 0.25 * std::max(p->fit.sa, 1e-12) ||
+                             std::abs(p->fit.tb - tb) > 0.25 * std::max(p->fit.sb, 1e-12);
+          if (moved && run + 1 < o.pair_runs) {
+            still.push_back(p);
+          } else {
+            p->fit.ta = ta;  // its chi2 is this run's; the uncertainties are the refit's
+            p->fit.tb = tb;
+          }
+        }
+        going = still;
+      }
+      for (PairWork& p : all)
+        if (!p.at_fit.empty()) pairs.push_back(p);
+    }
+  }
   // All runs are made: every comparison weighs by the final pooled spread.
   d.baseline = compare(ms, pool.pooled(s0), 0);
   d.baseline_bic = d.baseline.bic;
@@ -776,6 +948,42 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     }
     r.plausible =
         w.c.discrete || (r.fitted >= w.c.lo && r.fitted <= w.c.hi && !r.at_bound && !r.at_limit);
+    d.candidates.push_back(r);
+  }
+  for (const PairWork& p : pairs) {
+    const EffectCandidate& ca = p.a->c;
+    const EffectCandidate& cb = p.b->c;
+    const PairFitResult& f = p.fit;
+    CandidateResult r;
+    r.candidate = ca;
+    r.candidate.effect = ca.effect + "+" + cb.effect;
+    r.candidate.parameter =
+        ca.parameter + " (with " + cb.effect + ": " + cb.parameter + " = " + cb.format(f.tb) + ")";
+    const double tb = f.tb;
+    r.candidate.apply = [ca, cb, tb](const ParticleModel& m, double v) {
+      return cb.apply(ca.apply(m, v), tb);
+    };
+    r.fitted = f.ta;
+    r.fitted_std = f.sa;
+    r.fitted_lo = f.lo_a;
+    r.fitted_hi = f.hi_a;
+    r.with_effect = cb.effect;
+    r.with_candidate = cb;
+    r.with_fitted = f.tb;
+    r.with_std = f.sb;
+    r.with_lo = f.lo_b;
+    r.with_hi = f.hi_b;
+    r.comparison = compare(ms, pool.pooled(p.at_fit), 2);
+    r.chi2_source = "run";
+    r.chi2_at = f.ta;
+    r.delta_chi2 = d.baseline.chi2 - r.comparison.chi2;
+    r.bic = r.comparison.chi2 + 2.0 * ln_n;
+    auto inside = [](const EffectCandidate& c, double v) {
+      const double span = c.hi - c.lo;
+      return v > c.lo + 0.01 * span && v < c.hi - 0.01 * span;
+    };
+    r.at_bound = !inside(ca, f.ta) || !inside(cb, f.tb);
+    r.plausible = !r.at_bound;
     d.candidates.push_back(r);
   }
   std::sort(d.candidates.begin(), d.candidates.end(),
@@ -922,9 +1130,20 @@ std::string Diagnosis::summary() const {
         confidence);
   } else {
     const CandidateResult& t = candidates.front();
-    s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}{}), confidence {:.2f}\n",
-                     verdict, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
-                     t.candidate.discrete ? "" : "; 95 %: " + interval_text(t), confidence);
+    if (t.with_effect.empty()) {
+      s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}{}), confidence {:.2f}\n",
+                       verdict, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
+                       t.candidate.discrete ? "" : "; 95 %: " + interval_text(t), confidence);
+    } else {
+      const std::string first = t.candidate.effect.substr(0, t.candidate.effect.find('+'));
+      const EffectCandidate& w = t.with_candidate;
+      s += fmt::format(
+          "verdict: two missing effects, '{}' ({} +/- {:.2g}; 95 %: {}) and '{}' ({} = {} +/- "
+          "{:.2g}; 95 %: {:.3g} to {:.3g}), confidence {:.2f}; no single effect explains the "
+          "data\n",
+          first, t.candidate.format(t.fitted), t.fitted_std, interval_text(t), t.with_effect,
+          w.parameter, w.format(t.with_fitted), t.with_std, t.with_lo, t.with_hi, confidence);
+    }
     if (t.at_limit)
       s += "  warning: the fitted value is pinned at the edge of what the rigs could measure (" +
            t.limit + "): the strength may be larger than fitted\n";

@@ -42,6 +42,17 @@ struct DiagnoseOptions {
   /// above the best chi2 any real run has reached gets no confirmation run: its chi2 is the
   /// surrogate's (CandidateResult::chi2_source). 25 is a BIC weight below e^-12 of the leader's.
   double confirm_margin = 25.0;
+  /// Fit pairs of continuous effects where no single effect explains the data (a run of the
+  /// best single one has p < p_inconsistent): the `pair_top` best pairs on the sum of their
+  /// responses that would beat the best single effect by min_delta_bic are run (at most
+  /// `pair_runs` times each) and ranked with two parameters (BIC k = 2).
+  /// Pairs need at least this many observables: with fewer, a pair's chi2 has two degrees of
+  /// freedom or less, and a noisy draw is fitted as a second effect (the noisy rolling-friction
+  /// test on three heaps ranked rolling + wall friction first in 2 of 40 draws).
+  bool pairs = true;
+  int pair_min_observables = 5;
+  int pair_top = 3;
+  int pair_runs = 2;
   bool suggest = true;  ///< simulate unmeasured settings to suggest a measurement
   /// Simulate them even when no measurement is needed: the model is consistent with the data,
   /// or the verdict is decisive (confidence >= suggest_below and no effect indistinguishable).
@@ -77,6 +88,11 @@ struct CandidateResult {
   std::string limit;
   bool at_limit = false;
   double weight = 0.0;  ///< posterior weight among baseline + candidates (BIC)
+  /// A pair of effects (DiagnoseOptions::pairs): candidate.effect is "first+second", `fitted`
+  /// the first's value, these the second's; candidate.apply adds both. Empty: one effect.
+  std::string with_effect;
+  EffectCandidate with_candidate;
+  double with_fitted = 0.0, with_std = 0.0, with_lo = 0.0, with_hi = 0.0;
 };
 
 struct Suggestion {
