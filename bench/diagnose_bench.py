@@ -22,6 +22,10 @@ Cases (truth vs baseline; every other effect as in Table 1):
                      Table 1's mu_r
   size_distribution  a height spread of 0.15 (mass-weighted relative std), baseline one height
   none               truth = baseline (the diagnosis must not give a verdict)
+  rolling_friction+cohesion
+                     two effects hidden at once: mu_r 0.2 on every pair and a cohesion of
+                     5000 J/m^3, baseline mu_r 0.05 without cohesion (a pair needs at least 5
+                     observables: add cups, e.g. --cups abs_plastic,organic_glass,galvanized_steel)
 
 Writes OUT/results.md (a table) and OUT/<case>/ (models, data, JSON, HTML reports); the rig
 results are cached in OUT/cache, shared by the cases, so a second run of the script simulates
@@ -76,6 +80,10 @@ CASES = {
     "rolling_model": ({"rolling_model": ['model = "cdt"']}, {}, "cdt"),
     "size_distribution": ({"size_distribution": ["height_spread = 0.15"]}, {}, 0.15),
     "none": ({}, {}, None),
+    "rolling_friction+cohesion": (
+        {"rolling_friction": per_partner(0.2, ["pill"] + WALLS),
+         "cohesion": ['energy_density = "5000 J/m^3"']},
+        {"rolling_friction": per_partner(0.05, ["pill"] + WALLS)}, "0.2 + 5000 J/m^3"),
 }
 
 
@@ -171,14 +179,17 @@ def main():
             "top": top["effect"] if top else "-",
             "fitted": top["fitted"]["value"] if top else None,
             "fitted_std": top["fitted"]["std"] if top else None,
+            "with": top.get("with") if top else None,
             "chi2dof_base": dj.get("baseline", {}).get("chi2_per_dof"),
             "chi2dof_after": list(chain.values())[-1] if chain else None,
             "runs": dj["simulations"], "synth_s": t1 - t0, "diagnose_s": t2 - t1,
             "again_s": t3 - t2, "again_runs": again_runs,
             "skipped": dj.get("skipped", [])})
         r = rows[-1]
+        with_text = (f" with {r['with']['effect']} {r['with']['fitted']['value']} +/- "
+                     f"{r['with']['fitted']['std']}" if r.get("with") else "")
         print(f"{case}: verdict {r['verdict']} (top {r['top']} {r['fitted']} +/- "
-              f"{r['fitted_std']}, truth {truth_value}), chi2/dof {r['chi2dof_base']} -> "
+              f"{r['fitted_std']}{with_text}, truth {truth_value}), chi2/dof {r['chi2dof_base']} -> "
               f"{r['chi2dof_after']}, {r['runs']} rig runs, synth {r['synth_s']:.0f} s, "
               f"diagnose {r['diagnose_s']:.0f} s, again from the cache {r['again_s']:.1f} s "
               f"({r['again_runs']} runs)", flush=True)
@@ -193,6 +204,9 @@ def main():
         for r in rows:
             fit = (f"{r['top']}: {r['fitted']:.4g} ± {r['fitted_std']:.2g}"
                    if r["fitted"] is not None else r["top"])
+            if r.get("with"):
+                fit += (f" with {r['with']['fitted']['value']:.4g} ± "
+                        f"{r['with']['fitted']['std']:.2g}")
             after = f"{r['chi2dof_after']:.2f}" if r["chi2dof_after"] is not None else "-"
             base = f"{r['chi2dof_base']:.2f}" if r["chi2dof_base"] is not None else "-"
             f.write(f"| {r['case']} | {r['verdict']} ({r['confidence']:.2f}) | {fit} | "

@@ -326,6 +326,7 @@ Command setup_diagnose(CLI::App& parent) {
                     {"indistinguishable", d.indistinguishable},
                     {"suggestions", sugg},
                     {"suggestion_note", d.suggestion_note},
+                    {"screen_only", d.screen_only},
                     {"skipped", d.skipped},
                     {"simulations", d.simulations},
                     {"summary", d.summary()}};

@@ -172,6 +172,21 @@ TEST(Diagnosis, NoFalseVerdictWhenNothingIsMissing) {
     const Diagnosis d = diagnose(base, ms, sim, o);
     EXPECT_TRUE(d.consistent) << d.summary();
     EXPECT_TRUE(d.verdict.empty());
+    // Consistent after the screen: no refinement or confirmation runs (the baseline, one probe
+    // per continuous effect and one run per discrete level), the same verdict as with them.
+    EXPECT_TRUE(d.screen_only) << d.summary();
+    for (const CandidateResult& r : d.candidates)  // "run": fitted at the baseline's own run
+      EXPECT_TRUE(r.chi2_source == "surrogate" || r.chi2_source == "screen" ||
+                  r.chi2_source == "nearest_run" ||
+                  (r.chi2_source == "run" && r.fitted == r.candidate.baseline))
+          << r.candidate.effect << " " << r.chi2_source;
+    DiagnoseOptions full = o;
+    full.p_screen_only = 1.01;
+    fake::FakeSimulator sim2;
+    const Diagnosis d2 = diagnose(base, ms, sim2, full);
+    EXPECT_FALSE(d2.screen_only);
+    EXPECT_TRUE(d2.consistent) << d2.summary();
+    EXPECT_LT(d.simulations, d2.simulations);
   }
 }
 

@@ -582,8 +582,20 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // are inconsistent with the baseline and a candidate's fit lies on the side it was not probed
   // on, its surrogate there is a guess: one screening run at the mirrored probe gives it a point
   // before the candidates are ranked.
-  const bool inconsistent =
-      chi2_survival(compare(ms, pool.pooled(s0), 0).chi2, n) < o.p_inconsistent;
+  const double p_screened = chi2_survival(compare(ms, pool.pooled(s0), 0).chi2, n);
+  const bool inconsistent = p_screened < o.p_inconsistent;
+  // A baseline the screen leaves consistent with the data (p >= p_screen_only) gets no verdict
+  // whatever the refinements find (a verdict needs p < p_inconsistent): the candidates keep
+  // their screened fits (chi2 from the surrogate; discrete levels from their screening runs),
+  // and no refinement or confirmation run is made (with nothing hidden, half of a diagnosis).
+  const bool screen_only = p_screened >= o.p_screen_only;
+  if (screen_only) {
+    d.screen_only = true;
+    say(
+        fmt::format("the baseline is consistent with the data after the screen (p = {:.3g}): "
+                    "no refinement or confirmation runs",
+                    p_screened));
+  }
   // One more screening run for each (candidate, value), side by side, and a refit.
   auto screen_more = [&](const std::vector<std::pair<Work*, double>>& runs, const char* where) {
     std::vector<ParticleModel> models;
@@ -646,7 +658,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // are followed by one more refinement (short of the failure) than `refinements`.
   std::vector<Work*> refining;
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r)
-    if (!work[order[r]].c.discrete && o.refinements > 0) refining.push_back(&work[order[r]]);
+    if (!work[order[r]].c.discrete && o.refinements > 0 && !screen_only)
+      refining.push_back(&work[order[r]]);
   while (!refining.empty()) {
     std::vector<ParticleModel> models;
     for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
@@ -710,7 +723,8 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       // repeat's noise must not choose between levels (the CDT and EPSD rolling models both
       // lower a heap; the better-screened one is not always the better one).
       for (const auto& [level, v] : w.level_runs)
-        if (!full(v) && compare(ms, pool.pooled(v), 1).chi2 < best_real + o.confirm_margin)
+        if (!screen_only && !full(v) &&
+            compare(ms, pool.pooled(v), 1).chi2 < best_real + o.confirm_margin)
           confirm.emplace_back(&w, level);
       continue;
     }
@@ -726,7 +740,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       w.at = nearest->first;
       w.source = nearest->first == w.fit.theta ? "run" : "nearest_run";
       w.have_at_fit = true;
-    } else if (w.fit.chi2 >= best_real + o.confirm_margin) {
+    } else if (screen_only || w.fit.chi2 >= best_real + o.confirm_margin) {
       // The surrogate's prediction, each value with the variance the fit gave it.
       for (const auto& m : ms) {
         const SimulatedValue& b = pooled0.at(m.key());
@@ -739,10 +753,10 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       w.at = w.fit.theta;
       w.source = "surrogate";
       w.have_at_fit = true;
-      say(
-          fmt::format("{}: not confirmed: its surrogate chi2 at {} is {:.1f}, {:.1f} above the "
-                      "best run",
-                      w.c.effect, w.c.format(w.fit.theta), w.fit.chi2, w.fit.chi2 - best_real));
+      if (!screen_only)
+        say(fmt::format(
+            "{}: not confirmed: its surrogate chi2 at {} is {:.1f}, {:.1f} above the best run",
+            w.c.effect, w.c.format(w.fit.theta), w.fit.chi2, w.fit.chi2 - best_real));
     } else {
       confirm.emplace_back(&w, w.fit.theta);
     }
@@ -816,6 +830,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         w.at_fit = v;
         w.at = level;
         w.have_at_fit = true;
+        w.source = full(v) ? "run" : "screen";
       }
     }
   }
@@ -1128,6 +1143,9 @@ std::string Diagnosis::summary() const {
         "verdict: the model is consistent with the data; no effect improves it decisively "
         "(baseline weight {:.2f})\n",
         confidence);
+    if (screen_only)
+      s += "  (the baseline was consistent after the screen, so the candidates were screened "
+           "only: their chi2 is the response surrogate's or a one-repeat screening run's)\n";
   } else {
     const CandidateResult& t = candidates.front();
     if (t.with_effect.empty()) {

@@ -220,6 +220,7 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
                     json{{"key", e.key}, {"values", values}, {"result", r.to_json()}}.dump(1));
   std::lock_guard<std::mutex> lock(mutex_);
   ++runs_;
+  made_.insert(e.file);
   return v;
 }
 
@@ -228,7 +229,7 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
   const Entry e = entry(model, req, repeats, seed);
   folders_.push_back(e.run_dir);
   if (auto v = read_cached(e.file, e.key)) {
-    ++hits_;
+    if (!made_.count(e.file)) ++hits_;
     return *v;
   }
   return run(e, req, repeats, seed, opt_.threads);

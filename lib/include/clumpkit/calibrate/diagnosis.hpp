@@ -38,6 +38,9 @@ struct DiagnoseOptions {
   int extra_refinements = 2;
   double min_delta_bic = 6.0;  ///< "strong" evidence (Kass & Raftery)
   double p_inconsistent = 0.01;
+  /// A baseline whose chi2 survival after the screen is at least this gets no refinement or
+  /// confirmation runs (no verdict is possible; Diagnosis::screen_only). 1.01: never.
+  double p_screen_only = 0.05;
   /// A continuous candidate whose response surrogate puts its chi2 at the fitted value this far
   /// above the best chi2 any real run has reached gets no confirmation run: its chi2 is the
   /// surrogate's (CandidateResult::chi2_source). 25 is a BIC weight below e^-12 of the leader's.
@@ -73,10 +76,12 @@ struct CandidateResult {
   /// short on the flat side); an open side reaches the fit's range. Discrete: both = fitted.
   double fitted_lo = 0.0, fitted_hi = 0.0;
   Comparison comparison;  ///< against the data, at `chi2_at` (see chi2_source)
-  /// How `comparison` was obtained: "run" (a simulation at `fitted`), "nearest_run" (the
+  /// How `comparison` was obtained: "run" (a simulation at `fitted`), "screen" (a discrete
+  /// level's one-repeat screening run, Diagnosis::screen_only), "nearest_run" (the
   /// simulation at `chi2_at`, within a quarter of the fitted uncertainty of `fitted`: Delta chi2
   /// below ~0.06 by the fit's own curvature) or "surrogate" (no run: the response surrogate
-  /// puts this candidate at least DiagnoseOptions::confirm_margin above the best run).
+  /// puts this candidate at least DiagnoseOptions::confirm_margin above the best run, or
+  /// Diagnosis::screen_only).
   std::string chi2_source = "run";
   double chi2_at = 0.0;
   double delta_chi2 = 0.0;  ///< baseline chi2 - this chi2
@@ -108,7 +113,10 @@ struct Diagnosis {
   std::vector<CandidateResult> candidates;  ///< best first
   std::vector<std::string> skipped;         ///< effects not tried, with the reason
   bool consistent = true;                   ///< no verdict: the baseline explains the data
-  std::string verdict;                      ///< the winning effect, empty when consistent
+  /// The baseline explained the data after the screen (p >= p_screen_only): no candidate was
+  /// refined or confirmed (their chi2_source: "surrogate" or "screen").
+  bool screen_only = false;
+  std::string verdict;               ///< the winning effect, empty when consistent
   double confidence = 0.0;           ///< posterior weight of the verdict (or of the baseline)
   std::vector<std::string> drivers;  ///< observables that drive the verdict
   std::vector<std::string> indistinguishable;  ///< effects within 2 BIC units of the best

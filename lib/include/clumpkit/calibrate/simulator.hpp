@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,8 @@ class RigSimulator final : public Simulator {
   /// Runs the jobs not yet in the cache, `Options::jobs` at a time; the first failure is
   /// rethrown after the running ones finish (no new ones start).
   void prefetch(const std::vector<SimJob>& jobs, int repeats, std::uint64_t seed) override;
+  /// Requests served from results this simulator did not make itself (an earlier process's;
+  /// not what its own prefetch() ran a moment before).
   long cache_hits() const { return hits_; }
   /// PNG pictures (heap silhouettes, discharge curves) of the runs served so far.
   std::vector<std::filesystem::path> pictures() const;
@@ -107,7 +110,8 @@ class RigSimulator final : public Simulator {
   Options opt_;
   long hits_ = 0;
   std::vector<std::filesystem::path> folders_;
-  std::mutex mutex_;  ///< guards runs_, folders_ and progress output during prefetch()
+  std::set<std::filesystem::path> made_;  ///< cache files this simulator wrote
+  std::mutex mutex_;  ///< guards runs_, made_, folders_ and progress output during prefetch()
 };
 
 /// Converts a rig result's SI statistics to canonical-unit simulated values per quantity.
