@@ -339,12 +339,17 @@ Command setup_diagnose(CLI::App& parent) {
             const CandidateResult& top = d.candidates.front();
             ParticleModel next = top.candidate.apply(base, top.fitted);
             next.name = base.name + "+" + top.candidate.effect;
+            // A pair's parameter text carries its second effect: "mu_r (with cohesion: ...)".
+            const std::string param =
+                top.candidate.parameter.substr(0, top.candidate.parameter.find(" (with "));
+            std::string added = fmt::format("{} = {}", param, top.candidate.format(top.fitted));
+            if (!top.with_effect.empty())
+              added += fmt::format(" and {} = {}", top.with_candidate.parameter,
+                                   top.with_candidate.format(top.with_fitted));
             write_file_atomic(a->output,
                               format_model(next, a->output,
-                                           fmt::format("{} with {} = {} added by clumpkit "
-                                                       "diagnose",
-                                                       base.name, top.candidate.parameter,
-                                                       top.candidate.format(top.fitted))));
+                                           fmt::format("{} with {} added by clumpkit diagnose",
+                                                       base.name, added)));
             out["applied"] = {{"effect", top.candidate.effect}, {"model", a->output}};
             rep.chain.emplace_back(next.name, top.comparison);
             std::cout << "wrote " << a->output << " (" << next.name << ")\n";
