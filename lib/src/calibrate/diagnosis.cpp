@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
+#include <map>
 #include <set>
 #include <tuple>
 
@@ -839,9 +839,9 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   // far (a hidden rolling friction and cohesion both raise the heap; cohesion alone, fitted to
   // the heaps, then lowers the cup too much), and the next diagnosis cannot add the other,
   // since the heaps already match. Every pair of continuous candidates is fitted on the sum of
-  // their surrogates (no runs); the best pair, if it beats the best single effect by
-  // min_delta_bic with its second parameter paid for, is run at its fit (every repeat), and
-  // once more where that run moves the fit (the sum's miss at the run added as an offset).
+  // their surrogates (no runs); the best `pair_top` that would beat the best single effect by
+  // min_delta_bic with their second parameter paid for are run at their fit (every repeat),
+  // and once more where that run moves the fit (the sum's miss at the run added as an offset).
   struct PairWork {
     Work* a = nullptr;
     Work* b = nullptr;
@@ -889,8 +889,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       // at the run added to it as an offset); it stands where it was last run.
       std::vector<PairWork*> going;
       for (PairWork& p : all) going.push_back(&p);
-      std::map<PairWork*, std::vector<double>> offsets;
-      std::map<PairWork*, std::pair<double, double>> ran;
+      std::map<PairWork*, std::pair<double, double>> ran;  // where each was last run
       for (int run = 0; run < o.pair_runs && !going.empty(); ++run) {
         std::vector<ParticleModel> models;
         for (PairWork* p : going) models.push_back(model_of(*p));
@@ -911,8 +910,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
           p->at_fit = v;
           const double ta = p->fit.ta, tb = p->fit.tb;
           ran[p] = {ta, tb};
-          std::vector<double>& offset = offsets[p];
-          offset.assign(ms.size(), 0.0);
+          std::vector<double> offset(ms.size(), 0.0);
           for (size_t k = 0; k < ms.size(); ++k) {
             const std::string key = ms[k].key();
             offset[k] = v.at(key).mean - (p->a->s.value(key, ta) + p->b->s.value(key, tb) -
