@@ -260,7 +260,7 @@ Command setup_diagnose(CLI::App& parent) {
           std::cout << fmt::format(
               "{:<18} {:<38} {:>14} {:>10.3g} {:>22} {:>9.2f} {:>+9.2f} {:>9.2f} {:>7.3f} {:<13} "
               "{}\n",
-              r.candidate.effect, r.candidate.parameter, r.candidate.format(r.fitted), r.fitted_std,
+              r.candidate.effect, parameter_text(r), r.candidate.format(r.fitted), r.fitted_std,
               interval_text(r), r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
               r.plausible  ? "yes"
               : r.at_limit ? "no (at limit)"
@@ -274,37 +274,32 @@ Command setup_diagnose(CLI::App& parent) {
         std::cout << fmt::format("{} rig runs simulated, {} served from the cache\n", sim.runs(),
                                  sim.cache_hits());
         json cands = json::array();
+        // An effect's fit: the candidate's (or a pair's second effect's) parameter and values.
+        auto fit_json = [](const EffectCandidate& e, double value, double sd, double lo,
+                           double hi) {
+          return json{{"effect", e.effect},
+                      {"parameter", e.parameter},
+                      {"unit", e.unit},
+                      {"fitted", {{"value", value}, {"std", sd}, {"interval_95", {lo, hi}}}},
+                      {"range", {e.lo, e.hi}}};
+        };
         for (const auto& r : d.candidates) {
-          json with = nullptr;  // the second effect of a pair
-          if (!r.with_effect.empty())
-            with = {{"effect", r.with_effect},
-                    {"parameter", r.with_candidate.parameter},
-                    {"unit", r.with_candidate.unit},
-                    {"fitted",
-                     {{"value", r.with_fitted},
-                      {"std", r.with_std},
-                      {"interval_95", {r.with_lo, r.with_hi}}}},
-                    {"range", {r.with_candidate.lo, r.with_candidate.hi}}};
-          cands.push_back({{"effect", r.candidate.effect},
-                           {"parameter", r.candidate.parameter},
-                           {"unit", r.candidate.unit},
-                           {"fitted",
-                            {{"value", r.fitted},
-                             {"std", r.fitted_std},
-                             {"interval_95", {r.fitted_lo, r.fitted_hi}}}},
-                           {"range", {r.candidate.lo, r.candidate.hi}},
-                           {"chi2", r.comparison.chi2},
-                           {"chi2_per_dof", r.comparison.chi2_per_dof},
-                           {"delta_chi2", r.delta_chi2},
-                           {"bic", r.bic},
-                           {"weight", r.weight},
-                           {"plausible", r.plausible},
-                           {"at_bound", r.at_bound},
-                           {"limit", r.limit},
-                           {"at_limit", r.at_limit},
-                           {"chi2_source", r.chi2_source},
-                           {"chi2_at", r.chi2_at},
-                           {"with", with}});
+          json entry = fit_json(r.candidate, r.fitted, r.fitted_std, r.fitted_lo, r.fitted_hi);
+          entry.update({{"chi2", r.comparison.chi2},
+                        {"chi2_per_dof", r.comparison.chi2_per_dof},
+                        {"delta_chi2", r.delta_chi2},
+                        {"bic", r.bic},
+                        {"weight", r.weight},
+                        {"plausible", r.plausible},
+                        {"at_bound", r.at_bound},
+                        {"limit", r.limit},
+                        {"at_limit", r.at_limit},
+                        {"chi2_source", r.chi2_source},
+                        {"chi2_at", r.chi2_at},
+                        {"with", r.with ? fit_json(r.with->candidate, r.with->fitted, r.with->std,
+                                                   r.with->lo, r.with->hi)
+                                        : json(nullptr)}});
+          cands.push_back(entry);
         }
         json sugg = json::array();
         for (const auto& s : d.suggestions)
@@ -339,13 +334,11 @@ Command setup_diagnose(CLI::App& parent) {
             const CandidateResult& top = d.candidates.front();
             ParticleModel next = top.candidate.apply(base, top.fitted);
             next.name = base.name + "+" + top.candidate.effect;
-            // A pair's parameter text carries its second effect: "mu_r (with cohesion: ...)".
-            const std::string param =
-                top.candidate.parameter.substr(0, top.candidate.parameter.find(" (with "));
-            std::string added = fmt::format("{} = {}", param, top.candidate.format(top.fitted));
-            if (!top.with_effect.empty())
-              added += fmt::format(" and {} = {}", top.with_candidate.parameter,
-                                   top.with_candidate.format(top.with_fitted));
+            std::string added =
+                fmt::format("{} = {}", top.candidate.parameter, top.candidate.format(top.fitted));
+            if (top.with)
+              added += fmt::format(" and {} = {}", top.with->candidate.parameter,
+                                   top.with->candidate.format(top.with->fitted));
             write_file_atomic(a->output,
                               format_model(next, a->output,
                                            fmt::format("{} with {} added by clumpkit diagnose",

@@ -612,7 +612,7 @@ TEST(Diagnosis, TwoHiddenEffectsAreFoundTogether) {
   const Diagnosis d = diagnose(base, ms, sim, o);
   ASSERT_FALSE(d.consistent) << d.summary();
   const CandidateResult& top = d.candidates.front();
-  ASSERT_FALSE(top.with_effect.empty()) << d.summary();
+  ASSERT_TRUE(top.with.has_value()) << d.summary();
   EXPECT_EQ(d.verdict, top.candidate.effect);
   EXPECT_NE(d.summary().find("two missing effects"), std::string::npos) << d.summary();
   EXPECT_GE(chi2_survival(top.comparison.chi2, top.comparison.dof), 0.01) << d.summary();
@@ -631,10 +631,10 @@ TEST(Diagnosis, TwoHiddenEffectsAreFoundTogether) {
               std::find(named.begin(), named.end(), truth_pair->candidate.effect) != named.end())
       << d.summary();
   const bool rf_first = truth_pair->candidate.effect == "rolling_friction+cohesion";
-  const double mur = rf_first ? truth_pair->fitted : truth_pair->with_fitted;
-  const double mur_std = rf_first ? truth_pair->fitted_std : truth_pair->with_std;
-  const double coh = rf_first ? truth_pair->with_fitted : truth_pair->fitted;
-  const double coh_std = rf_first ? truth_pair->with_std : truth_pair->fitted_std;
+  const double mur = rf_first ? truth_pair->fitted : truth_pair->with->fitted;
+  const double mur_std = rf_first ? truth_pair->fitted_std : truth_pair->with->std;
+  const double coh = rf_first ? truth_pair->with->fitted : truth_pair->fitted;
+  const double coh_std = rf_first ? truth_pair->with->std : truth_pair->fitted_std;
   EXPECT_LE(std::abs(mur - 0.12), 2.0 * mur_std + 1e-12) << d.summary();
   EXPECT_LE(std::abs(coh - 9000.0), 2.0 * coh_std + 1e-9) << d.summary();
   // --apply adds both: the new model is consistent with the data.
@@ -650,7 +650,7 @@ TEST(Diagnosis, TwoHiddenEffectsAreFoundTogether) {
   fake::FakeSimulator sim1;
   const Diagnosis d1 = diagnose(base, ms, sim1, single);
   ASSERT_FALSE(d1.consistent);
-  EXPECT_TRUE(d1.candidates.front().with_effect.empty());
+  EXPECT_FALSE(d1.candidates.front().with.has_value());
   EXPECT_LT(
       chi2_survival(d1.candidates.front().comparison.chi2, d1.candidates.front().comparison.dof),
       0.01)

@@ -396,6 +396,13 @@ std::string interval_text(const CandidateResult& r) {
   return fmt::format("{:.3g} to {:.3g}", r.fitted_lo, r.fitted_hi);
 }
 
+std::string parameter_text(const CandidateResult& r) {
+  if (!r.with) return r.candidate.parameter;
+  const EffectCandidate& w = r.with->candidate;
+  return fmt::format("{} (with {}: {} = {})", r.candidate.parameter, w.effect, w.parameter,
+                     w.format(r.with->fitted));
+}
+
 std::string chi2_source_text(const CandidateResult& r) {
   if (r.chi2_source == "nearest_run") return "run at " + r.candidate.format(r.chi2_at);
   return r.chi2_source;
@@ -970,8 +977,6 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     CandidateResult r;
     r.candidate = ca;
     r.candidate.effect = ca.effect + "+" + cb.effect;
-    r.candidate.parameter =
-        ca.parameter + " (with " + cb.effect + ": " + cb.parameter + " = " + cb.format(f.tb) + ")";
     const double tb = f.tb;
     r.candidate.apply = [ca, cb, tb](const ParticleModel& m, double v) {
       return cb.apply(ca.apply(m, v), tb);
@@ -980,12 +985,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     r.fitted_std = f.sa;
     r.fitted_lo = f.lo_a;
     r.fitted_hi = f.hi_a;
-    r.with_effect = cb.effect;
-    r.with_candidate = cb;
-    r.with_fitted = f.tb;
-    r.with_std = f.sb;
-    r.with_lo = f.lo_b;
-    r.with_hi = f.hi_b;
+    r.with = CandidateResult::SecondEffect{cb, f.tb, f.sb, f.lo_b, f.hi_b};
     r.comparison = compare(ms, pool.pooled(p.at_fit), 2);
     r.chi2_source = "run";
     r.chi2_at = f.ta;
@@ -1035,23 +1035,20 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
 
   // Which unmeasured rig setting would best separate the two leading explanations? Only asked
   // where the answer is needed (DiagnoseOptions::suggest_always).
-  bool suggest = o.suggest && d.candidates.size() >= 2 && o.suggest_max > 0;
   if (!o.suggest || o.suggest_max <= 0) {
     d.suggestion_note = "not simulated (switched off)";
   } else if (d.candidates.size() < 2) {
     d.suggestion_note = "not simulated: fewer than two candidates to tell apart";
   } else if (!o.suggest_always && d.consistent) {
-    suggest = false;
     d.suggestion_note =
         "none needed: the model is consistent with the data (--suggest always simulates one)";
   } else if (!o.suggest_always && d.indistinguishable.empty() && d.confidence >= o.suggest_below) {
-    suggest = false;
     d.suggestion_note = fmt::format(
         "none needed: the verdict is decisive (confidence {:.2f}, no other effect within 2 BIC "
         "units; --suggest always simulates one)",
         d.confidence);
   }
-  if (suggest) {
+  if (d.suggestion_note.empty()) {
     const CandidateResult& a = d.candidates[0];
     const CandidateResult& b = d.candidates[1];
     const ParticleModel ma = a.candidate.apply(base, a.fitted);
@@ -1146,19 +1143,20 @@ std::string Diagnosis::summary() const {
            "only: their chi2 is the response surrogate's or a one-repeat screening run's)\n";
   } else {
     const CandidateResult& t = candidates.front();
-    if (t.with_effect.empty()) {
+    if (!t.with) {
       s += fmt::format("verdict: missing effect '{}' ({} = {} +/- {:.2g}{}), confidence {:.2f}\n",
                        verdict, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
                        t.candidate.discrete ? "" : "; 95 %: " + interval_text(t), confidence);
     } else {
+      const EffectCandidate& w = t.with->candidate;
       const std::string first = t.candidate.effect.substr(0, t.candidate.effect.find('+'));
-      const EffectCandidate& w = t.with_candidate;
       s += fmt::format(
-          "verdict: two missing effects, '{}' ({} +/- {:.2g}; 95 %: {}) and '{}' ({} = {} +/- "
-          "{:.2g}; 95 %: {:.3g} to {:.3g}), confidence {:.2f}; no single effect explains the "
+          "verdict: two missing effects, '{}' ({} = {} +/- {:.2g}; 95 %: {}) and '{}' ({} = {} "
+          "+/- {:.2g}; 95 %: {:.3g} to {:.3g}), confidence {:.2f}; no single effect explains the "
           "data\n",
-          first, t.candidate.format(t.fitted), t.fitted_std, interval_text(t), t.with_effect,
-          w.parameter, w.format(t.with_fitted), t.with_std, t.with_lo, t.with_hi, confidence);
+          first, t.candidate.parameter, t.candidate.format(t.fitted), t.fitted_std,
+          interval_text(t), w.effect, w.parameter, w.format(t.with->fitted), t.with->std,
+          t.with->lo, t.with->hi, confidence);
     }
     if (t.at_limit)
       s += "  warning: the fitted value is pinned at the edge of what the rigs could measure (" +

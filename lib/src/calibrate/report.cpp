@@ -219,7 +219,7 @@ std::string report_html(const ReportInput& in) {
           "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.3g}</td><td>{}</td>"
           "<td>{:.2f}</td><td>{:.2f}</td><td>{:.2f}</td><td>{:.3f}</td><td>{}</td>"
           "<td class=\"l\">{}</td></tr>\n",
-          esc(r.candidate.effect), esc(r.candidate.parameter), esc(r.candidate.format(r.fitted)),
+          esc(r.candidate.effect), esc(parameter_text(r)), esc(r.candidate.format(r.fitted)),
           r.fitted_std, esc(interval_text(r)), r.comparison.chi2, r.delta_chi2, r.bic, r.weight,
           r.plausible  ? "yes"
           : r.at_limit ? "no (at limit)"

@@ -12,6 +12,7 @@
 /// the report says that the model is consistent with the data.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -93,11 +94,14 @@ struct CandidateResult {
   std::string limit;
   bool at_limit = false;
   double weight = 0.0;  ///< posterior weight among baseline + candidates (BIC)
-  /// A pair of effects (DiagnoseOptions::pairs): candidate.effect is "first+second", `fitted`
-  /// the first's value, these the second's; candidate.apply adds both. Empty: one effect.
-  std::string with_effect;
-  EffectCandidate with_candidate;
-  double with_fitted = 0.0, with_std = 0.0, with_lo = 0.0, with_hi = 0.0;
+  /// A pair of effects (DiagnoseOptions::pairs): candidate.effect is "first+second", the rest
+  /// of `candidate` and `fitted` are the first's, `with` is the second's fit; candidate.apply
+  /// adds both. Empty: one effect.
+  struct SecondEffect {
+    EffectCandidate candidate;
+    double fitted = 0.0, std = 0.0, lo = 0.0, hi = 0.0;  ///< value, 1 sigma, 95 % interval
+  };
+  std::optional<SecondEffect> with;
 };
 
 struct Suggestion {
@@ -133,6 +137,9 @@ Diagnosis diagnose(const ParticleModel& baseline, const std::vector<Measurement>
 std::string chi2_source_text(const CandidateResult& r);
 /// "0.17 to 0.23" (the 95 % interval, in the parameter's unit), "-" for a discrete candidate.
 std::string interval_text(const CandidateResult& r);
+/// The candidate's parameter, and a pair's second one with its value: "mu_r (with cohesion:
+/// SJKR energy density = 8750 J/m^3)".
+std::string parameter_text(const CandidateResult& r);
 
 /// Survival function of the chi-square distribution, P(X >= x) with `dof` degrees of freedom.
 double chi2_survival(double x, int dof);
