@@ -172,6 +172,47 @@ TEST(World, FactoryReportsARegionTooSmall) {
   EXPECT_THROW((void)World::create(s), InputError);
 }
 
+// LIGGGHTS' all_in no: only the centre of mass must lie in the region, so a region not much
+// larger than a pill takes several times more pills per batch; walls and other pills are still
+// never overlapped.
+TEST(World, FactoryPlacesOnlyCentresInTheRegionWhenAsked) {
+  auto first_batch = [](bool whole) {
+    WorldSettings s = pour(1);
+    FactorySettings& f = s.factories[0];
+    f.region =
+        BoxRegion{Eigen::Vector3d(-0.004, -0.004, 0.02), Eigen::Vector3d(0.004, 0.004, 0.028)};
+    f.mixture = {{"A", 1.0}};
+    f.count = 1000;
+    f.rate = 1000.0;  // clumps/s: the whole count due in the first batch, as many as fit
+    f.interval = 1.0;
+    f.fail_if_behind = false;
+    f.whole_in_region = whole;
+    return World::create(s);
+  };
+  const World whole = first_batch(true), centre = first_batch(false);
+  ASSERT_GE(whole.clump_count(), 1);
+  EXPECT_GE(centre.clump_count(), 3 * whole.clump_count())
+      << whole.clump_count() << " whole, " << centre.clump_count() << " by centre";
+  const Eigen::AlignedBox3d region(Eigen::Vector3d(-0.004, -0.004, 0.02),
+                                   Eigen::Vector3d(0.004, 0.004, 0.028));
+  for (const auto& x : centre.positions()) EXPECT_TRUE(region.contains(x));
+  const auto& p = centre.sphere_positions();
+  const auto& r = centre.sphere_radii();
+  const auto& owner = centre.sphere_clumps();
+  int outside = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    outside += !region.contains(p[i]);
+    // Spheres of different pills never overlap.
+    for (size_t j = i + 1; j < p.size(); ++j) {
+      if (owner[i] != owner[j]) {
+        EXPECT_GE((p[i] - p[j]).norm(), r[i] + r[j] - 1e-12) << i << " " << j;
+      }
+    }
+  }
+  EXPECT_GT(outside, 0);  // pills reach out of the region
+  for (const auto& x : whole.sphere_positions()) EXPECT_TRUE(region.contains(x));
+}
+
 TEST(World, FactoryMixtureByMassAndRate) {
   WorldSettings s = pour(1);
   FactorySettings& f = s.factories[0];

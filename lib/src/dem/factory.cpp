@@ -45,7 +45,8 @@ Eigen::Quaterniond random_rotation(std::mt19937_64& rng) {
   return Eigen::Quaterniond(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
 }
 
-// A centre of mass at which a clump of bounding radius `bound` lies inside the region.
+// A centre of mass at which a clump of bounding radius `bound` lies inside the region (0: a
+// centre anywhere in it).
 Eigen::Vector3d random_point(const Region& region, double bound, std::mt19937_64& rng) {
   if (const auto* b = std::get_if<BoxRegion>(&region)) {
     Eigen::Vector3d p;
@@ -131,10 +132,14 @@ void World::Impl::run_factories() {
       box = Eigen::AlignedBox3d(c.base_center - Eigen::Vector3d(c.radius, c.radius, 0.0),
                                 c.base_center + Eigen::Vector3d(c.radius, c.radius, c.height));
     }
+    // Clumps whose centre only is in the region reach out of it by up to their bounding radius.
+    double reach = 0.0;
+    if (!f.s.whole_in_region)
+      for (int t : f.types) reach = std::max(reach, types[t].bound_radius);
     PlacementGrid grid{std::max(2.0 * r_max, 1e-9), {}, {}, {}};
     Eigen::AlignedBox3d grown = box;
-    grown.min().array() -= 2.0 * r_max;
-    grown.max().array() += 2.0 * r_max;
+    grown.min().array() -= 2.0 * r_max + reach;
+    grown.max().array() += 2.0 * r_max + reach;
     for (size_t s = 0; s < s_pos.size(); ++s)
       if (grown.contains(s_pos[s])) grid.add(s_pos[s], s_r[s]);
     std::vector<std::array<Eigen::Vector3d, 3>> tris;
@@ -170,7 +175,8 @@ void World::Impl::run_factories() {
       }
       bool ok = false;
       for (int attempt = 0; attempt < f.s.attempts_per_clump && !ok; ++attempt) {
-        const Eigen::Vector3d x = random_point(region, td.bound_radius, f.rng);
+        const Eigen::Vector3d x =
+            random_point(region, f.s.whole_in_region ? td.bound_radius : 0.0, f.rng);
         const Eigen::Quaterniond q =
             f.s.random_orientation ? random_rotation(f.rng) : Eigen::Quaterniond::Identity();
         const Eigen::Matrix3d R = q.toRotationMatrix();

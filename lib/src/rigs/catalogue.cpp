@@ -50,6 +50,12 @@ const std::vector<RigInfo>& rig_catalogue() {
          {{"bulk_density", Dimension::Density, "kg/m^3", 1.0, "mass in the cylinder / 0.26 L"}},
          {scale,
           {"wall", walls, "", "organic_glass", "material of the measuring cylinder"},
+          {"pour_region",
+           {"whole", "centre"},
+           "",
+           "whole",
+           "pills placed wholly inside the pour region, or only their centres (a faster pour)",
+           false},
           stiffness,
           damping}});
     r.push_back({"angle_of_repose",

@@ -162,6 +162,7 @@ dem::FactorySettings parse_factory(const TomlDoc& doc, const std::string& key) {
   f.velocity =
       doc.vector_opt(key + ".velocity", Dimension::Velocity).value_or(Eigen::Vector3d::Zero());
   f.random_orientation = doc.boolean_opt(key + ".random_orientation").value_or(true);
+  f.whole_in_region = doc.boolean_opt(key + ".whole_in_region").value_or(true);
   const size_t n = doc.array_size(key + ".mixture");
   if (n == 0) doc.fail(key + ".mixture", "missing: list of {clump = NAME, fraction = F}");
   for (size_t i = 0; i < n; ++i) {

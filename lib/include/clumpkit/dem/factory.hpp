@@ -44,6 +44,11 @@ struct FactorySettings {
   double interval = 0.0;    ///< s between batches; 0 = the free-fall time of the region
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< initial velocity, m/s
   bool random_orientation = true;
+  /// true: every sphere of an inserted clump lies inside the region (LIGGGHTS' `all_in yes`);
+  /// false: only its centre of mass does (LIGGGHTS' default, `all_in no`): a small region then
+  /// holds several times more clumps per batch, which protrude from it by up to their bounding
+  /// radius (walls and other clumps are still never overlapped).
+  bool whole_in_region = true;
   int attempts_per_clump = 200;  ///< random placements tried before giving up on a clump
   /// With a rate: true = an InputError when the region stays full and the factory falls more
   /// than two batches behind (a scene asked for more than its region can deliver); false = pour

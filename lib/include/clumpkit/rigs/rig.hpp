@@ -32,7 +32,10 @@ struct ScaleParams {
   // bulk_density
   double cup_diameter = 0.070, cup_height = 0.0676;  ///< m
   double pour_rate = 0.5;                            ///< kg/s
-  double scraper_speed = 0.05;                       ///< m/s
+  /// Bulk density pour: every pill inside the pour region (true) or only its centre (false,
+  /// LIGGGHTS' `all_in no`: more pills per batch from the same region, a faster pour).
+  bool pour_whole_in_region = true;
+  double scraper_speed = 0.05;  ///< m/s
   // angle_of_repose
   double tube_diameter = 0.0657, tube_height = 0.150;  ///< m
   double plate_side = 0.5;                             ///< m
