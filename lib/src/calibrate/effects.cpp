@@ -21,9 +21,24 @@ std::string EffectCandidate::format(double v) const {
 
 namespace {
 
+// The variant's name tells the progress lines which run is which: "base [rolling_friction=0.16]".
+std::string variant_label(const std::string& key, const std::string& value) {
+  std::string k = key.rfind("effects.", 0) == 0 ? key.substr(8) : key;
+  std::string v = value;
+  size_t used = 0;
+  try {
+    const double x = std::stod(value, &used);
+    v = fmt::format("{:.4g}", x) + value.substr(used);
+  } catch (const std::exception&) {
+    // not a number: a level name such as "cdt"
+  }
+  return k + "=" + v;
+}
+
 ParticleModel with(const ParticleModel& base, const std::string& key, const std::string& value) {
   ParticleModel m = base;
   set_model_effect(m, key, value, "diagnosis");
+  m.name = base.name + " [" + variant_label(key, value) + "]";
   return m;
 }
 

@@ -199,7 +199,11 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
     };
   if (opt_.progress) {
     std::lock_guard<std::mutex> lock(mutex_);
-    opt_.progress(fmt::format("simulating {} sample {} [{}] model {} x{}", req.rig, req.sample,
+    // The run's number and the time since this simulator began: a diagnosis's only clock.
+    const double minutes =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count() / 60.0;
+    opt_.progress(fmt::format("[rig run {}, {:.1f} min] simulating {} sample {} [{}] model {} x{}",
+                              ++started_, minutes, req.rig, req.sample,
                               format_settings(req.settings), e.model.name, repeats));
   }
   const rigs::RigResult r = rigs::run_rig(rr);

@@ -3,6 +3,7 @@
 /// observables of one (model, rig, sample, setting) at a number of repeats; RigSimulator runs
 /// the real rigs and caches every result on disk, keyed by the model's content, rig, sample,
 /// setting, scale, seed and repeats, so nothing is simulated twice.
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -111,7 +112,9 @@ class RigSimulator final : public Simulator {
   long hits_ = 0;
   std::vector<std::filesystem::path> folders_;
   std::set<std::filesystem::path> made_;  ///< cache files this simulator wrote
-  std::mutex mutex_;  ///< guards runs_, made_, folders_ and progress output during prefetch()
+  long started_ = 0;                      ///< rig runs begun, for the progress lines
+  std::chrono::steady_clock::time_point created_ = std::chrono::steady_clock::now();
+  std::mutex mutex_;  ///< guards runs_, made_, started_, folders_ and progress output
 };
 
 /// Converts a rig result's SI statistics to canonical-unit simulated values per quantity.
