@@ -591,6 +591,33 @@ TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
     EXPECT_FALSE(d.suggestions.empty()) << d.summary();
     EXPECT_TRUE(d.suggestion_note.empty()) << d.suggestion_note;
   }
+  {
+    // A runner-up pinned at the top of its plausible range: heaps raised by a cohesion that
+    // rolling friction matches only at its bound (0.5), 2.8 BIC units behind (weight 0.2). A
+    // red flag, not an explanation: no measurement is simulated to rule it out.
+    ParticleModel sticky = base;
+    set_model_effect(sticky, "effects.cohesion", "1.66e4 J/m^3", "test");
+    const std::string heaps =
+        "rig,sample,setting,quantity,value,std,n,unit\n"
+        "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
+        "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
+        "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n";
+    fake::FakeSimulator sim;
+    const auto ms = synthesize(sim, sticky, 0.02, 21, heaps);
+    DiagnoseOptions two = o;
+    two.effects = {"rolling_friction", "cohesion"};
+    const Diagnosis d = diagnose(base, ms, sim, two);
+    ASSERT_EQ(d.verdict, "cohesion") << d.summary();
+    ASSERT_EQ(d.candidates.size(), 2u);
+    EXPECT_TRUE(d.candidates[1].at_bound) << d.summary();
+    EXPECT_LT(d.confidence, two.suggest_below) << d.summary();  // the rule that would ask
+    EXPECT_TRUE(d.suggestions.empty()) << d.summary();
+    EXPECT_NE(d.suggestion_note.find("pinned"), std::string::npos) << d.suggestion_note;
+    DiagnoseOptions always = two;
+    always.suggest_always = true;
+    fake::FakeSimulator sim2;
+    EXPECT_FALSE(diagnose(base, ms, sim2, always).suggestions.empty());
+  }
 }
 
 // Two effects hidden at once (rolling friction and cohesion both raise the heap; cohesion also

@@ -1047,6 +1047,27 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
         "none needed: the verdict is decisive (confidence {:.2f}, no other effect within 2 BIC "
         "units; --suggest always simulates one)",
         d.confidence);
+  } else if (!o.suggest_always && d.indistinguishable.empty() && d.candidates[0].plausible) {
+    // A runner-up pinned at its range's bound asks for an implausible strength (a red flag,
+    // not an explanation): the verdict's weight among the plausible ones decides.
+    double rest = 0.0;
+    std::string pinned;
+    for (size_t i = 1; i < d.candidates.size(); ++i) {
+      const CandidateResult& c = d.candidates[i];
+      if (c.plausible || c.fitted <= c.candidate.lo + 0.01 * (c.candidate.hi - c.candidate.lo))
+        rest += c.weight;  // a plausible rival, or one pinned at "none" (the baseline's twin)
+      else if (c.weight >= 0.01)
+        pinned += fmt::format("{}{} at {}", pinned.empty() ? "" : ", ", c.candidate.effect,
+                              c.candidate.format(c.fitted));
+    }
+    const double top = d.candidates[0].weight;
+    const double among = top / (top + rest + baseline_weight);
+    if (among >= o.suggest_below && !pinned.empty())
+      d.suggestion_note = fmt::format(
+          "none needed: the verdict is decisive among plausible effects (confidence {:.2f}, "
+          "{:.2f} without {}, pinned at the bound of its plausible range; --suggest always "
+          "simulates one)",
+          d.confidence, among, pinned);
   }
   if (d.suggestion_note.empty()) {
     const CandidateResult& a = d.candidates[0];
