@@ -53,8 +53,9 @@ const std::vector<RigInfo>& rig_catalogue() {
           {"pour_region",
            {"whole", "centre"},
            "",
-           "whole",
-           "pills placed wholly inside the pour region, or only their centres (a faster pour)",
+           "by scale",
+           "pills wholly inside the pour region (tiny to small), or only their centres (paper: "
+           "a faster pour)",
            false},
           stiffness,
           damping}});
