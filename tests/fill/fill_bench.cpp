@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "clumpkit/fill/fill_problem.hpp"
@@ -121,8 +122,24 @@ int main(int argc, char** argv) {
   std::vector<double> ratio_targets;
   double tolerance = -1.0;
   std::string svg, mesh;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string k = argv[i], v = argv[i + 1];
+  const char* usage =
+      "usage: fill_bench [--shapes a,b,...] [--counts 4,8,...] [--methods edt,optimal,paper]\n"
+      "                  [--ratio E1,E2,...] [--tolerance T] [--svg FILE] [--mesh FILE.stl]\n";
+  const std::set<std::string> keys = {"--shapes", "--methods", "--ratio",    "--svg",
+                                      "--mesh",   "--counts",  "--tolerance"};
+  for (int i = 1; i < argc; i += 2) {
+    const std::string k = argv[i];
+    if (k == "--help" || k == "-h") {
+      std::cout << usage;
+      return 0;
+    }
+    if (!keys.count(k) || i + 1 >= argc) {
+      std::cerr << "fill_bench: " << (keys.count(k) ? "no value for " : "unknown option ") << k
+                << "\n"
+                << usage;
+      return 2;
+    }
+    const std::string v = argv[i + 1];
     if (k == "--shapes") shapes = split(v);
     if (k == "--methods") methods = split(v);
     if (k == "--ratio")
