@@ -1054,8 +1054,12 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     std::string pinned;
     for (size_t i = 1; i < d.candidates.size(); ++i) {
       const CandidateResult& c = d.candidates[i];
-      if (c.plausible || c.fitted <= c.candidate.lo + 0.01 * (c.candidate.hi - c.candidate.lo))
-        rest += c.weight;  // a plausible rival, or one pinned at "none" (the baseline's twin)
+      // Only the top of the physical range counts: a fit stopped by failed runs (at_limit) or
+      // pinned at "none" (the baseline's twin) is a rival like any other.
+      const bool at_top =
+          c.at_bound && c.fitted >= c.candidate.hi - 0.01 * (c.candidate.hi - c.candidate.lo);
+      if (!at_top)
+        rest += c.weight;
       else if (c.weight >= 0.01)
         pinned += fmt::format("{}{} at {}", pinned.empty() ? "" : ", ", c.candidate.effect,
                               c.candidate.format(c.fitted));
