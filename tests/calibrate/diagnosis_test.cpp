@@ -547,6 +547,14 @@ TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
   set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
   DiagnoseOptions o;
   o.effects = {"rolling_friction", "cohesion", "particle_friction"};
+  // Heap angles alone, and the two effects that raise them alike.
+  const std::string heaps =
+      "rig,sample,setting,quantity,value,std,n,unit\n"
+      "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
+      "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
+      "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n";
+  DiagnoseOptions two = o;
+  two.effects = {"rolling_friction", "cohesion"};
   {
     // Decisive: the whole template separates rolling friction from cohesion.
     fake::FakeSimulator sim;
@@ -576,15 +584,8 @@ TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
   }
   {
     // Ambiguous: heap angles alone, which rolling friction and cohesion raise alike.
-    const std::string heaps =
-        "rig,sample,setting,quantity,value,std,n,unit\n"
-        "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n";
     fake::FakeSimulator sim;
     const auto ms = synthesize(sim, truth, 0.02, 19, heaps);
-    DiagnoseOptions two = o;
-    two.effects = {"rolling_friction", "cohesion"};
     const Diagnosis d = diagnose(base, ms, sim, two);
     ASSERT_FALSE(d.consistent) << d.summary();
     ASSERT_FALSE(d.indistinguishable.empty()) << d.summary();
@@ -597,15 +598,8 @@ TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
     // red flag, not an explanation: no measurement is simulated to rule it out.
     ParticleModel sticky = base;
     set_model_effect(sticky, "effects.cohesion", "1.66e4 J/m^3", "test");
-    const std::string heaps =
-        "rig,sample,setting,quantity,value,std,n,unit\n"
-        "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n";
     fake::FakeSimulator sim;
     const auto ms = synthesize(sim, sticky, 0.02, 21, heaps);
-    DiagnoseOptions two = o;
-    two.effects = {"rolling_friction", "cohesion"};
     const Diagnosis d = diagnose(base, ms, sim, two);
     ASSERT_EQ(d.verdict, "cohesion") << d.summary();
     ASSERT_EQ(d.candidates.size(), 2u);

@@ -1056,8 +1056,7 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
       const CandidateResult& c = d.candidates[i];
       // Only the top of the physical range counts: a fit stopped by failed runs (at_limit) or
       // pinned at "none" (the baseline's twin) is a rival like any other.
-      const bool at_top =
-          c.at_bound && c.fitted >= c.candidate.hi - 0.01 * (c.candidate.hi - c.candidate.lo);
+      const bool at_top = c.at_bound && c.fitted > 0.5 * (c.candidate.lo + c.candidate.hi);
       if (!at_top)
         rest += c.weight;
       else if (c.weight >= 0.01)
