@@ -155,14 +155,39 @@ static inline void half_kick(World::Impl& w, int c, double h) {
   w.c_wb[c] = pi.cwiseProduct(t.inv_inertia);
 }
 
+// One sub-step of the free rotation: the body turns by θ = τ π_K / I_K about principal axis K.
+// The axis is a template argument so that the five sub-steps of a step are straight-line code
+// with every index known (this chain of dependent operations is most of the drift's cost).
+template <int K>
+inline void free_rotation_substep(double tau, const TypeData& t, Eigen::Vector3d& pi, double& qw,
+                                  Eigen::Vector3d& qv) {
+  const double theta = tau * pi[K] * t.inv_inertia[K];
+  if (theta == 0.0) return;
+  // One sincos of θ/2 serves the quaternion and (by the double-angle formulas) the momentum
+  // rotation.
+  double sh, ch;
+  half_angle_sincos(0.5 * theta, sh, ch);
+  rotate_momentum(pi, K, 1.0 - 2.0 * sh * sh, 2.0 * sh * ch);
+  // q ← q · (ch, sh e_K), written out: the factor has one vector component.
+  constexpr int a = (K + 1) % 3, b = (K + 2) % 3;
+  const double w0 = qw, vk = qv[K], va = qv[a], vb = qv[b];
+  qw = w0 * ch - sh * vk;
+  qv[K] = w0 * sh + ch * vk;
+  qv[a] = ch * va + sh * vb;
+  qv[b] = ch * vb - sh * va;
+}
+
 void World::Impl::kick_and_drift() {
   const int nc = static_cast<int>(c_x.size());
   const int ns = static_cast<int>(s_r.size());
   const double h = 0.5 * dt;
   TopTwo top;
-  // One loop over the clumps, each moving its own spheres (fewer fork-joins per step, no
-  // gather of clump poses per sphere); the clumps' largest displacements since the last
-  // neighbour rebuild come along for free.
+  // Two loops over the clumps in one parallel region: the first kicks and turns each clump,
+  // the second moves its spheres. Apart, the first loop's iterations are short enough for the
+  // processor to overlap the dependent sincos chains of neighbouring clumps. Both loops share
+  // the static schedule, so each thread moves the spheres of the clumps it turned (no barrier
+  // between them). The clumps' largest displacements since the last neighbour rebuild come
+  // along for free.
 #pragma omp parallel num_threads(threads) if (ns >= kParallelMin)
   {
     TopTwo mine;
@@ -175,33 +200,22 @@ void World::Impl::kick_and_drift() {
       Eigen::Vector3d pi = t.inertia.cwiseProduct(c_wb[c]);
       double qw = c_q[c].w();
       Eigen::Vector3d qv = c_q[c].vec();
-      static constexpr int kAxis[5] = {0, 1, 2, 1, 0};
-      for (int st = 0; st < 5; ++st) {
-        const int k = kAxis[st];
-        const double tau = st == 2 ? dt : h;
-        const double theta = tau * pi[k] * t.inv_inertia[k];
-        if (theta == 0.0) continue;
-        // One sincos of θ/2 serves the quaternion and (by the double-angle formulas) the
-        // momentum rotation.
-        double sh, ch;
-        half_angle_sincos(0.5 * theta, sh, ch);
-        rotate_momentum(pi, k, 1.0 - 2.0 * sh * sh, 2.0 * sh * ch);
-        // q ← q · (ch, sh e_k), written out: the factor has one vector component.
-        const int a = (k + 1) % 3, b = (k + 2) % 3;
-        const double w0 = qw, vk = qv[k], va = qv[a], vb = qv[b];
-        qw = w0 * ch - sh * vk;
-        qv[k] = w0 * sh + ch * vk;
-        qv[a] = ch * va + sh * vb;
-        qv[b] = ch * vb - sh * va;
-      }
+      free_rotation_substep<0>(h, t, pi, qw, qv);
+      free_rotation_substep<1>(h, t, pi, qw, qv);
+      free_rotation_substep<2>(dt, t, pi, qw, qv);
+      free_rotation_substep<1>(h, t, pi, qw, qv);
+      free_rotation_substep<0>(h, t, pi, qw, qv);
       Eigen::Quaterniond q(qw, qv.x(), qv.y(), qv.z());
       q.normalize();
       c_q[c] = q;
-      const Eigen::Matrix3d R = q.toRotationMatrix();
-      c_R[c] = R;
+      c_R[c] = q.toRotationMatrix();
       c_wb[c] = pi.cwiseProduct(t.inv_inertia);
-      // The clump's spheres (contiguous) follow while its pose is at hand.
+    }
+#pragma omp for schedule(static) nowait
+    for (int c = 0; c < nc; ++c) {
+      // The clump's spheres (contiguous).
       const Eigen::Vector3d& x = c_x[c];
+      const Eigen::Matrix3d& R = c_R[c];
       double dc = 0.0;
       for (int s = c_first[c]; s < sphere_end(c); ++s) {
         s_pos[s] = x + R * s_off[s];
