@@ -184,6 +184,14 @@ struct Ctx {
   void say(const std::string& s) const {
     if (req.progress) req.progress(fmt::format("[{} repeat {}] {}", req.rig, repeat + 1, s));
   }
+  // A progress line at most every 5 s of wall time on the long loops (pour, strike-off, lift,
+  // discharge); `line` is formatted only when one is due.
+  template <class F>
+  void progress(F&& line) {
+    if (std::chrono::duration<double>(Clock::now() - last_progress).count() <= 5.0) return;
+    say(line());
+    last_progress = Clock::now();
+  }
 };
 
 dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& wall_materials) {
@@ -358,11 +366,10 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
     if (t_factories < 0 && w.factories_done()) t_factories = w.time();
     s.rms_speed = rms_speed(w);
     quiet = (t_factories >= 0 && s.rms_speed < c.p.settle_speed) ? quiet + 1 : 0;
-    if (std::chrono::duration<double>(Clock::now() - c.last_progress).count() > 5.0) {
-      c.say(fmt::format("{}: t = {:.3f} s, {} clumps, rms speed {:.4f} m/s", what, w.time(),
-                        w.clump_count(), s.rms_speed));
-      c.last_progress = Clock::now();
-    }
+    c.progress([&] {
+      return fmt::format("{}: t = {:.3f} s, {} clumps, rms speed {:.4f} m/s", what, w.time(),
+                         w.clump_count(), s.rms_speed);
+    });
     if (quiet >= 3) {
       s.settled = true;
       break;
@@ -540,6 +547,10 @@ RepeatResult bulk_density(Ctx& c) {
     w.run_until(std::min(t_scrape, w.time() + 0.02));
     cull(c, w);
     keep_checkpoint(c, w, 2, state, false);
+    c.progress([&] {
+      return fmt::format("strike-off: t = {:.3f} of {:.3f} s, {} clumps", w.time(), t_scrape,
+                         w.clump_count());
+    });
   }
   c.say(fmt::format("scraped at t = {:.3f} s", w.time()));
   const SettleInfo s2 = settle(c, w, 2, state, "after strike-off");
@@ -657,11 +668,10 @@ RepeatResult angle_of_repose(Ctx& c) {
       }
     }
     keep_checkpoint(c, w, 2, state, false);
-    if (std::chrono::duration<double>(Clock::now() - c.last_progress).count() > 5.0) {
-      c.say(fmt::format("lifting: t = {:.3f} of {:.3f} s, rms speed {:.4f} m/s", w.time(), t_lift,
-                        rms_speed(w)));
-      c.last_progress = Clock::now();
-    }
+    c.progress([&] {
+      return fmt::format("lifting: t = {:.3f} of {:.3f} s, rms speed {:.4f} m/s", w.time(), t_lift,
+                         rms_speed(w));
+    });
   }
   const SettleInfo s2 = settle(c, w, 2, state, "heap flow");
   snapshot(c, w, "heap");
@@ -850,6 +860,11 @@ RepeatResult discharge(Ctx& c) {
     state["removed_kg"] = c.removed_mass;
     keep_checkpoint(c, w, 2, state, false);
     if (w.time() >= t_end - 1e-12 && next >= size_t(need)) break;
+    c.progress([&] {
+      return fmt::format(
+          "discharge: t = {:.3f} of {:.3f} s, {} of {} pockets closed, {:.4f} kg out", w.time(),
+          t_end, next, need, c.removed_mass);
+    });
   }
   snapshot(c, w, "discharged");
 
