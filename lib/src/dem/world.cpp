@@ -65,6 +65,70 @@ World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
 World::~World() = default;
 
+namespace {
+
+// A factory's runtime from its settings, validated; k is its index (names the field in errors
+// and seeds its random stream). `s` holds the clump types and the seed (World::create and
+// World::add_factory).
+FactoryRuntime make_factory(const World::Impl& w, const WorldSettings& s, const FactorySettings& fs,
+                            size_t k) {
+  const std::string& where = s.source;
+  const std::string f = "factories[" + std::to_string(k) + "]";
+  FactoryRuntime fr;
+  fr.s = fs;
+  if (fs.count.has_value() == fs.mass.has_value())
+    throw InputError(where, f, "give exactly one of count and mass");
+  if (fs.count && *fs.count < 0) throw InputError(where, f + ".count", "must be >= 0");
+  if (fs.mass && !(*fs.mass >= 0.0 && std::isfinite(*fs.mass)))
+    throw InputError(where, f + ".mass", "must be >= 0 kg");
+  if (!(fs.rate >= 0.0) || !std::isfinite(fs.rate))
+    throw InputError(where, f + ".rate", "must be >= 0");
+  if (!(fs.interval >= 0.0)) throw InputError(where, f + ".interval", "must be >= 0 s");
+  if (fs.attempts_per_clump < 1) throw InputError(where, f + ".attempts_per_clump", "must be >= 1");
+  if (fs.mixture.empty()) throw InputError(where, f + ".mixture", "no clump types given");
+  double total = 0.0;
+  for (size_t e = 0; e < fs.mixture.size(); ++e) {
+    const auto& me = fs.mixture[e];
+    int t = -1;
+    for (size_t u = 0; u < s.clump_types.size(); ++u)
+      if (s.clump_types[u].name == me.clump_type) t = static_cast<int>(u);
+    if (t < 0)
+      throw InputError(where, f + ".mixture[" + std::to_string(e) + "].clump_type",
+                       "unknown clump type '" + me.clump_type + "'");
+    if (!(me.mass_fraction > 0.0) || !std::isfinite(me.mass_fraction))
+      throw InputError(where, f + ".mixture[" + std::to_string(e) + "].mass_fraction",
+                       "must be > 0");
+    fr.types.push_back(t);
+    fr.fractions.push_back(me.mass_fraction);
+    total += me.mass_fraction;
+  }
+  for (double& x : fr.fractions) x /= total;
+  fr.type_mass.assign(fr.types.size(), 0.0);
+  // Region sanity: it must hold the largest clump of the mixture at all.
+  double bound = 0.0;
+  for (int t : fr.types) bound = std::max(bound, w.types[t].bound_radius);
+  bool fits = true;
+  if (const auto* b = std::get_if<BoxRegion>(&fs.region)) {
+    if (!b->min.allFinite() || !b->max.allFinite() || !((b->max - b->min).minCoeff() > 0.0))
+      throw InputError(where, f + ".region", "box min must be below max on every axis");
+    fits = (b->max - b->min).minCoeff() >= 2.0 * bound;
+  } else {
+    const auto& c = std::get<CylinderRegion>(fs.region);
+    if (!(c.radius > 0.0) || !(c.height > 0.0) || !c.base_center.allFinite())
+      throw InputError(where, f + ".region", "cylinder radius and height must be > 0");
+    fits = c.radius >= bound && c.height >= 2.0 * bound;
+  }
+  if (!fits)
+    throw InputError(where, f + ".region",
+                     "the region (" + describe(fs.region) +
+                         ") is smaller than a clump of the mixture (bounding radius " +
+                         fmt_g(bound * 1e3) + " mm)");
+  fr.rng.seed(s.seed + 0x9E3779B97F4A7C15ull * (k + 1));
+  return fr;
+}
+
+}  // namespace
+
 World World::create(WorldSettings s) {
   auto im = std::make_unique<Impl>();
   Impl& w = *im;
@@ -171,62 +235,8 @@ World World::create(WorldSettings s) {
     }
 
   // Factories.
-  for (size_t k = 0; k < s.factories.size(); ++k) {
-    const std::string f = "factories[" + std::to_string(k) + "]";
-    const FactorySettings& fs = s.factories[k];
-    FactoryRuntime fr;
-    fr.s = fs;
-    if (fs.count.has_value() == fs.mass.has_value())
-      throw InputError(where, f, "give exactly one of count and mass");
-    if (fs.count && *fs.count < 0) throw InputError(where, f + ".count", "must be >= 0");
-    if (fs.mass && !(*fs.mass >= 0.0 && std::isfinite(*fs.mass)))
-      throw InputError(where, f + ".mass", "must be >= 0 kg");
-    if (!(fs.rate >= 0.0) || !std::isfinite(fs.rate))
-      throw InputError(where, f + ".rate", "must be >= 0");
-    if (!(fs.interval >= 0.0)) throw InputError(where, f + ".interval", "must be >= 0 s");
-    if (fs.attempts_per_clump < 1)
-      throw InputError(where, f + ".attempts_per_clump", "must be >= 1");
-    if (fs.mixture.empty()) throw InputError(where, f + ".mixture", "no clump types given");
-    double total = 0.0;
-    for (size_t e = 0; e < fs.mixture.size(); ++e) {
-      const auto& me = fs.mixture[e];
-      int t = -1;
-      for (size_t u = 0; u < s.clump_types.size(); ++u)
-        if (s.clump_types[u].name == me.clump_type) t = static_cast<int>(u);
-      if (t < 0)
-        throw InputError(where, f + ".mixture[" + std::to_string(e) + "].clump_type",
-                         "unknown clump type '" + me.clump_type + "'");
-      if (!(me.mass_fraction > 0.0) || !std::isfinite(me.mass_fraction))
-        throw InputError(where, f + ".mixture[" + std::to_string(e) + "].mass_fraction",
-                         "must be > 0");
-      fr.types.push_back(t);
-      fr.fractions.push_back(me.mass_fraction);
-      total += me.mass_fraction;
-    }
-    for (double& x : fr.fractions) x /= total;
-    fr.type_mass.assign(fr.types.size(), 0.0);
-    // Region sanity: it must hold the largest clump of the mixture at all.
-    double bound = 0.0;
-    for (int t : fr.types) bound = std::max(bound, w.types[t].bound_radius);
-    bool fits = true;
-    if (const auto* b = std::get_if<BoxRegion>(&fs.region)) {
-      if (!b->min.allFinite() || !b->max.allFinite() || !((b->max - b->min).minCoeff() > 0.0))
-        throw InputError(where, f + ".region", "box min must be below max on every axis");
-      fits = (b->max - b->min).minCoeff() >= 2.0 * bound;
-    } else {
-      const auto& c = std::get<CylinderRegion>(fs.region);
-      if (!(c.radius > 0.0) || !(c.height > 0.0) || !c.base_center.allFinite())
-        throw InputError(where, f + ".region", "cylinder radius and height must be > 0");
-      fits = c.radius >= bound && c.height >= 2.0 * bound;
-    }
-    if (!fits)
-      throw InputError(where, f + ".region",
-                       "the region (" + describe(fs.region) +
-                           ") is smaller than a clump of the mixture (bounding radius " +
-                           fmt_g(bound * 1e3) + " mm)");
-    fr.rng.seed(s.seed + 0x9E3779B97F4A7C15ull * (k + 1));
-    w.factories.push_back(std::move(fr));
-  }
+  for (size_t k = 0; k < s.factories.size(); ++k)
+    w.factories.push_back(make_factory(w, s, s.factories[k], k));
 
   // Sizes, skin and the time step.
   w.r_min = std::numeric_limits<double>::infinity();
@@ -489,6 +499,21 @@ void World::set_wall_motion(int w, const WallMotion& motion) {
   im.settings.walls[w].motion = motion;
   // The pose at the current time; a jump (if any) triggers a neighbour rebuild next step.
   im.move_walls();
+}
+
+void World::add_factory(const FactorySettings& f) {
+  Impl& im = *impl_;
+  // Batches are scheduled from the start time: one in the past would be caught up at once.
+  if (!(f.start_time >= im.time))
+    throw InputError(im.settings.source,
+                     "factories[" + std::to_string(im.factories.size()) + "].start_time",
+                     "a factory added at t = " + fmt_g(im.time) +
+                         " s must start then or later (got " + fmt_g(f.start_time) + " s)");
+  im.factories.push_back(make_factory(im, im.settings, f, im.factories.size()));
+  im.settings.factories.push_back(f);
+  // A World created with this factory in its settings has the same fingerprint, so the
+  // checkpoints taken from now on load into it.
+  im.fingerprint = im.compute_fingerprint();
 }
 
 int World::remove_clumps(const std::function<bool(int)>& remove) {

@@ -201,6 +201,14 @@ class World {
   void set_wall_motion(int w, const WallMotion& motion);
 
   // Factories.
+  /// Adds a factory while running (a rig's second pour once the first has filled its
+  /// container), starting at its start_time, which must be time() or later (its first batch
+  /// runs at the first step ending at or after it). Its random stream is the one it would have
+  /// had as the next entry of the settings' factories, so a World created with it appended to
+  /// its settings loads the checkpoints taken after this call and runs on bit-identically (and
+  /// is the same state from the call on when start_time > time()). InputError on invalid
+  /// settings, naming factories[index].
+  void add_factory(const FactorySettings& f);
   int factory_count() const;
   const FactoryStatus& factory_status(int f) const;
   bool factories_done() const;
