@@ -459,8 +459,9 @@ dem::World open_world(Ctx& c, const dem::WorldSettings& ws, const nlohmann::json
 }
 
 // Phase 1: pour and settle.
-SettleInfo pour_and_settle(Ctx& c, dem::World& w, const std::string& what) {
-  SettleInfo info = settle(c, w, 1, {}, what);
+SettleInfo pour_and_settle(Ctx& c, dem::World& w, const std::string& what,
+                           const nlohmann::json& extra = {}) {
+  SettleInfo info = settle(c, w, 1, extra, what);
   c.say(fmt::format("{}: {} after {:.3f} s, {} clumps, rms speed {:.4f} m/s", what,
                     info.settled ? "settled" : "settle time cap reached", w.time(), w.clump_count(),
                     info.rms_speed));
@@ -621,25 +622,69 @@ RepeatResult angle_of_repose(Ctx& c) {
   if (fill.rate > 0) fill.rate = std::max(fill.rate, 0.3);
   ws.factories.push_back(fill);
 
+  // When the column holds less than the mass asked (paper scale: 0.5 kg in the 0.51 L tube needs
+  // a solid fraction of 0.71 at the pills' density, more than a poured bed reaches), the rest is
+  // poured as the paper does, from its D 60 × H 20 mm region 5 mm above the top (scaled with the
+  // tube), once the column is full; what does not fit runs over the rim onto the plate. The
+  // top-up is a second factory added when the column has settled; the state names it, so a
+  // resumed run creates it again.
+  auto top_up = [&](double t_start, double mass) {
+    const double rt = R * 60.0 / 65.7;
+    dem::FactorySettings f =
+        pour(c, dem::CylinderRegion{Vector3d(0, 0, g.height + 0.005), rt, 0.020}, mass);
+    f.name = "top-up";
+    f.rate = std::max(f.rate, 0.3);
+    f.start_time = t_start;
+    f.whole_in_region = false;  // by centre: the region holds few whole pills
+    return f;
+  };
   const int tube_wall = int(ws.walls.size()) - 1;
   // Pills that roll off the plate have left the rig.
   c.outside = [](const Vector3d& x) { return x.z() < -0.02; };
 
   nlohmann::json state = load_state(c);
+  if (state.contains("top_up"))
+    ws.factories.push_back(top_up(state["top_up"].at("t"), state["top_up"].at("kg")));
   dem::World w = open_world(c, ws, state, "fill");
   if (state.value("phase", 0) < 2) {
-    const SettleInfo s1 = pour_and_settle(c, w, "fill");
+    SettleInfo s1;
+    if (!state.contains("top_up")) {
+      s1 = pour_and_settle(c, w, "fill");
+      const double in_tube = w.factory_status(0).inserted_mass;
+      const double mean_pill = in_tube / std::max<long>(1, w.factory_status(0).inserted);
+      if (p.heap_mass - in_tube > 0.5 * mean_pill) {
+        state = {
+            {"top_up", {{"t", w.time()}, {"kg", p.heap_mass - in_tube}, {"in_tube_kg", in_tube}}}};
+        w.add_factory(top_up(w.time(), p.heap_mass - in_tube));
+        c.say(
+            fmt::format("the tube holds {:.3f} of the {:.3f} kg asked: pouring the rest from above "
+                        "its top, the overflow runs onto the plate",
+                        in_tube, p.heap_mass));
+        keep_checkpoint(c, w, 1, state, true);
+      }
+    }
+    if (state.contains("top_up")) s1 = pour_and_settle(c, w, "top-up", state);
+    double poured = 0;
+    for (int f = 0; f < w.factory_count(); ++f) poured += w.factory_status(f).inserted_mass;
+    if (poured < p.heap_mass - 0.5 * poured / std::max(1, w.clump_count()))
+      c.say(
+          fmt::format("warning: {:.3f} of the {:.3f} kg asked were poured (the heap reached the "
+                      "pour region)",
+                      poured, p.heap_mass));
+    const nlohmann::json fill_info = {
+        {"asked_kg", p.heap_mass},
+        {"poured_kg", poured},
+        {"column_kg", w.factory_status(0).inserted_mass},
+        {"top_up_kg", w.factory_count() > 1 ? w.factory_status(1).inserted_mass : 0.0}};
     double top = 0;
     for (int i = 0; i < w.clump_count(); ++i) top = std::max(top, w.positions()[i].z());
     snapshot(c, w, "filled");
     const double t_on = w.time() + 0.01;
     const double lift = p.lift_height > 0 ? p.lift_height : top + br + 0.01;
-    state = {{"t_action", t_on},
-             {"t_lift_end", t_on + lift / p.lift_speed},
-             {"lift_m", lift},
-             {"fill_time_s", w.time()},
-             {"settle_fill", settle_json(s1)},
-             {"bed_top_m", top + br}};
+    state = {
+        {"t_action", t_on},        {"t_lift_end", t_on + lift / p.lift_speed}, {"lift_m", lift},
+        {"fill_time_s", w.time()}, {"settle_fill", settle_json(s1)},           {"fill", fill_info},
+        {"bed_top_m", top + br}};
     start_action(c, w, tube_wall, tube(t_on, double(state["t_lift_end"])).motion, state);
   }
   double t_lift = state.at("t_lift_end");
@@ -705,6 +750,7 @@ RepeatResult angle_of_repose(Ctx& c) {
                {"mass_kg", w.total_mass()},
                {"lift_m", lift},
                {"settle_fill", state["settle_fill"]},
+               {"fill", state.value("fill", nlohmann::json::object())},
                {"settle_heap", settle_json(s2)},
                {"simulated_time_s", w.time()},
                {"time_step_s", w.dt()},
