@@ -66,8 +66,8 @@ TEST(RigEndToEnd, AngleOfReposeGivesAConeAndAPicture) {
 
 // A tube that cannot hold the mass asked (the paper scale's 0.5 kg) is filled, then topped up
 // from the region above its top, the overflow running onto the plate. A run stopped during the
-// top-up resumes with the second factory re-created and ends exactly where an uninterrupted run
-// does.
+// top-up, and again during the lift, resumes with the second factory re-created and ends exactly
+// where an uninterrupted run does.
 TEST(RigEndToEnd, AngleOfReposeTopsUpAFullTubeAndResumes) {
   const std::string set = "scale=tiny;mass=0.066;lift_speed=12000";
   const RigResult a = run_rig(request("angle_of_repose", set, "e2e_topup_a"));
@@ -83,15 +83,19 @@ TEST(RigEndToEnd, AngleOfReposeTopsUpAFullTubeAndResumes) {
   struct Stop {};
   RigRequest b = request("angle_of_repose", set, "e2e_topup_b");
   b.checkpoint_interval = 0.0;  // a checkpoint at every settle check
-  b.progress = [](const std::string& line) {
-    if (line.find("top-up: settle") != std::string::npos) throw Stop{};
-  };
-  EXPECT_THROW(run_rig(b), Stop);
-  const std::string state = [&] {
+  auto state = [&] {
     std::ifstream in(b.out / "repeat_1" / "state.json");
     return std::string(std::istreambuf_iterator<char>(in), {});
-  }();
-  EXPECT_NE(state.find("top_up"), std::string::npos) << state;
+  };
+  // Stopped at the end of the top-up (phase 1), then during the lift (phase 2).
+  for (const std::string stop_at : {"top-up: settle", "the tube cleared the heap"}) {
+    b.progress = [&](const std::string& line) {
+      if (line.find(stop_at) != std::string::npos) throw Stop{};
+    };
+    EXPECT_THROW(run_rig(b), Stop) << stop_at;
+    EXPECT_NE(state().find("top_up"), std::string::npos) << state();
+  }
+  EXPECT_NE(state().find("\"phase\": 2"), std::string::npos) << state();
   b.progress = nullptr;
   const RigResult rb = run_rig(b);
   ASSERT_TRUE(rb.error.empty()) << rb.error;

@@ -664,6 +664,7 @@ RepeatResult angle_of_repose(Ctx& c) {
       }
     }
     if (state.contains("top_up")) s1 = pour_and_settle(c, w, "top-up", state);
+    const nlohmann::json top_up_state = state.value("top_up", nlohmann::json());
     double poured = 0;
     for (int f = 0; f < w.factory_count(); ++f) poured += w.factory_status(f).inserted_mass;
     if (poured < p.heap_mass - 0.5 * poured / std::max(1, w.clump_count()))
@@ -685,6 +686,8 @@ RepeatResult angle_of_repose(Ctx& c) {
         {"t_action", t_on},        {"t_lift_end", t_on + lift / p.lift_speed}, {"lift_m", lift},
         {"fill_time_s", w.time()}, {"settle_fill", settle_json(s1)},           {"fill", fill_info},
         {"bed_top_m", top + br}};
+    // A resumed phase 2 creates the World with the top-up factory again (same fingerprint).
+    if (w.factory_count() > 1) state["top_up"] = top_up_state;
     start_action(c, w, tube_wall, tube(t_on, double(state["t_lift_end"])).motion, state);
   }
   double t_lift = state.at("t_lift_end");
