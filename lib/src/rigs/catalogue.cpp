@@ -67,7 +67,12 @@ const std::vector<RigInfo>& rig_catalogue() {
                  {scale,
                   {"plate", walls, "", "galvanized_steel", "material of the base plate"},
                   {"lift_speed", {}, "mm/min", "200", "lifting speed of the cylinder"},
-                  {"mass", {}, "kg", "0.5", "pill mass poured into the cylinder (scale default)"},
+                  {"mass",
+                   {},
+                   "kg",
+                   "0.5",
+                   "pill mass poured (scale default); what the cylinder cannot hold is poured "
+                   "from above its top and runs over onto the plate"},
                   stiffness,
                   damping}});
     r.push_back({"discharge",
