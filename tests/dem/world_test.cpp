@@ -253,7 +253,7 @@ TEST(World, FactoryAddedWhileRunningEqualsOneFromCreation) {
       BoxRegion{Eigen::Vector3d(-0.008, -0.008, 0.04), Eigen::Vector3d(0.008, 0.008, 0.055)};
   second.mixture = {{"B", 1.0}};
   second.count = 40;
-  second.rate = 2000.0;  // clumps/s, in batches of the region's free-fall time
+  second.rate = 2000.0;               // clumps/s, in batches of the region's free-fall time
   second.start_time = t_add + 0.005;  // after the call: both Worlds run its first batch alike
   second.fail_if_behind = false;
   second.whole_in_region = false;

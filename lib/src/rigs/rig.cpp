@@ -584,6 +584,12 @@ RepeatResult bulk_density(Ctx& c) {
 // ---------------------------------------------------------------------------------------------
 // angle_of_repose
 
+// The mean mass of the pills in the World, kg (half of it is the tolerance on a poured mass:
+// a factory by mass stops at the pill that comes closest).
+double mean_pill_mass(const dem::World& w) {
+  return w.total_mass() / std::max(1, w.clump_count());
+}
+
 RepeatResult angle_of_repose(Ctx& c) {
   const ScaleParams& p = c.p;
   const std::string plate_material =
@@ -651,10 +657,8 @@ RepeatResult angle_of_repose(Ctx& c) {
     if (!state.contains("top_up")) {
       s1 = pour_and_settle(c, w, "fill");
       const double in_tube = w.factory_status(0).inserted_mass;
-      const double mean_pill = in_tube / std::max<long>(1, w.factory_status(0).inserted);
-      if (p.heap_mass - in_tube > 0.5 * mean_pill) {
-        state = {
-            {"top_up", {{"t", w.time()}, {"kg", p.heap_mass - in_tube}, {"in_tube_kg", in_tube}}}};
+      if (p.heap_mass - in_tube > 0.5 * mean_pill_mass(w)) {
+        state = {{"top_up", {{"t", w.time()}, {"kg", p.heap_mass - in_tube}}}};
         w.add_factory(top_up(w.time(), p.heap_mass - in_tube));
         c.say(
             fmt::format("the tube holds {:.3f} of the {:.3f} kg asked: pouring the rest from above "
@@ -667,7 +671,7 @@ RepeatResult angle_of_repose(Ctx& c) {
     const nlohmann::json top_up_state = state.value("top_up", nlohmann::json());
     double poured = 0;
     for (int f = 0; f < w.factory_count(); ++f) poured += w.factory_status(f).inserted_mass;
-    if (poured < p.heap_mass - 0.5 * poured / std::max(1, w.clump_count()))
+    if (p.heap_mass - poured > 0.5 * mean_pill_mass(w))
       c.say(
           fmt::format("warning: {:.3f} of the {:.3f} kg asked were poured (the heap reached the "
                       "pour region)",
