@@ -160,9 +160,10 @@ void evaluate_contact(const ResolvedContact& law, const ContactKinematics& k, do
     // rescaled spring instead would store energy no force paid for (a jammed pill then gains
     // energy every step).
     const double cap = law.mu_s * std::abs(fn_contact);
-    const double fs = ft.norm();
-    if (fs > cap) {
-      ft *= cap / fs;
+    // Squared lengths compared: the square root only for a sliding contact.
+    const double fs2 = ft.squaredNorm();
+    if (fs2 > cap * cap) {
+      ft *= cap / std::sqrt(fs2);
       h.shear = -ft / st;
     } else if (law.damping) {
       out.dashpot_t = tangential_dashpot(law, st, k.m_star);

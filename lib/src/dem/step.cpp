@@ -214,12 +214,20 @@ void World::Impl::kick_and_drift() {
 #pragma omp for schedule(static) nowait
     for (int c = 0; c < nc; ++c) {
       // The clump's spheres (contiguous).
-      const Eigen::Vector3d& x = c_x[c];
-      const Eigen::Matrix3d& R = c_R[c];
+      // x + R o written out: Eigen called its generic product kernel once per sphere. The sums
+      // are associated as Eigen's x + R * o does (rows 0 and 1 as (a + b) + c, row 2 as
+      // a + (b + c)), so the positions keep their bits.
+      const Eigen::Vector3d x = c_x[c];
+      const Eigen::Matrix3d R = c_R[c];
       double dc = 0.0;
-      for (int s = c_first[c]; s < sphere_end(c); ++s) {
-        s_pos[s] = x + R * s_off[s];
-        dc = std::max(dc, (s_pos[s] - s_pos_build[s]).squaredNorm());
+      const int s1 = sphere_end(c);
+      for (int s = c_first[c]; s < s1; ++s) {
+        const Eigen::Vector3d& o = s_off[s];
+        const Eigen::Vector3d p(x.x() + ((R(0, 0) * o.x() + R(0, 1) * o.y()) + R(0, 2) * o.z()),
+                                x.y() + ((R(1, 0) * o.x() + R(1, 1) * o.y()) + R(1, 2) * o.z()),
+                                x.z() + (R(2, 0) * o.x() + (R(2, 1) * o.y() + R(2, 2) * o.z())));
+        s_pos[s] = p;
+        dc = std::max(dc, (p - s_pos_build[s]).squaredNorm());
       }
       mine.add(dc);
     }
@@ -391,14 +399,13 @@ void World::Impl::detect_contacts() {
       int wall, tri;
       Eigen::Vector3d point;
     };
-    if (wall_cand_start[s] == wall_cand_start[s + 1]) {
-      // No wall nearby: nothing to detect, nothing to carry over unless a contact is closing.
-      bool held = false;
-      for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
-      if (!held) {
-        wall_contact_n[s] = 0;
-        continue;
-      }
+    // A slot not held (wall −1) is all zero (it was only ever written as such), so a sphere
+    // that holds none and touches nothing has nothing to carry over or clear.
+    bool held = false;
+    for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
+    if (!held && wall_cand_start[s] == wall_cand_start[s + 1]) {
+      wall_contact_n[s] = 0;
+      continue;
     }
     Cand cands[32];
     int nc = 0;
@@ -414,6 +421,10 @@ void World::Impl::detect_contacts() {
                                                           wd.vertices[tri[1]], wd.vertices[tri[2]]);
       const double d = (p - c).norm();
       if (d < r) cands[nc++] = {d, wi, ti, c};
+    }
+    if (nc == 0 && !held) {  // the usual case: candidates within the skin, none touching
+      wall_contact_n[s] = 0;
+      continue;
     }
     std::sort(cands, cands + nc, [](const Cand& x, const Cand& y) {
       if (x.dist != y.dist) return x.dist < y.dist;
@@ -451,6 +462,15 @@ void World::Impl::detect_contacts() {
       ratio_s[a] = std::max(ratio_s[a], wc.overlap / r);
     }
     // Carry the history springs over: same wall, closest normal.
+    auto& slots = wall_slots[s];
+    if (n == 1 && slots[0].wall == out[0].wall && slots[1].wall < 0 && slots[2].wall < 0 &&
+        slots[3].wall < 0 && slots[0].normal.dot(out[0].normal) > 0.5) {
+      // The usual case, one contact that goes on: what the general case below gives, in place.
+      slots[0].normal = out[0].normal;
+      out[0].closing = false;
+      wall_contact_n[s] = 1;
+      continue;
+    }
     std::array<WallSlot, kWallSlots> next{};
     std::array<bool, kWallSlots> used{};
     const auto& prev = wall_slots[s];
