@@ -159,6 +159,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   w.s_pos_build.clear();
   w.wall_slots.clear();
   w.wall_contacts.clear();
+  w.wall_row.clear();
   w.wall_contact_n.clear();
   w.wall_cand_start.assign(1, 0);
   for (int t : types) {

@@ -282,14 +282,18 @@ void World::Impl::rebuild_neighbours() {
 void World::Impl::refresh_wall_active() {
   const int ns = static_cast<int>(s_r.size());
   wall_active.clear();
+  wall_row.assign(ns, -1);
   for (int s = 0; s < ns; ++s) {
     bool held = false;
     for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
-    if (held || wall_cand_start[s] != wall_cand_start[s + 1])
+    // The rows move: every count is rewritten by the detection that follows.
+    wall_contact_n[s] = 0;
+    if (held || wall_cand_start[s] != wall_cand_start[s + 1]) {
+      wall_row[s] = static_cast<int>(wall_active.size());
       wall_active.push_back(s);
-    else
-      wall_contact_n[s] = 0;
+    }
   }
+  wall_contacts.resize(wall_active.size());
   wall_active_dirty = false;
 }
 

@@ -431,7 +431,7 @@ void World::Impl::detect_contacts() {
       if (x.wall != y.wall) return x.wall < y.wall;
       return x.tri < y.tri;
     });
-    auto& out = wall_contacts[s];
+    auto& out = wall_contacts[a];
     int n = 0;
     for (int k = 0; k < nc; ++k) {
       const Cand& cd = cands[k];
@@ -512,11 +512,11 @@ void World::Impl::detect_contacts() {
     if (ratio_s[a] > max_overlap_ratio) {
       max_overlap_ratio = ratio_s[a];
       max_overlap_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
-                         walls[wall_contacts[s][0].wall].name + "'";
+                         walls[wall_contacts[a][0].wall].name + "'";
       for (int k = 0; k < wall_contact_n[s]; ++k)
-        if (wall_contacts[s][k].overlap / s_r[s] >= ratio_s[a])
+        if (wall_contacts[a][k].overlap / s_r[s] >= ratio_s[a])
           max_overlap_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
-                             walls[wall_contacts[s][k].wall].name + "'";
+                             walls[wall_contacts[a][k].wall].name + "'";
     }
     if (overflow[a] && !slot_overflow_warned) {
       slot_overflow_warned = true;
@@ -533,7 +533,7 @@ void World::Impl::visit_contacts(int c, Pair&& pair, Wall&& wall) const {
     pair(pair_contacts[scratch_j_list[e]], false);
   for (int k = scratch_i_start[c]; k < scratch_i_start[c + 1]; ++k) pair(pair_contacts[k], true);
   for (int s = c_first[c]; s < sphere_end(c); ++s)
-    for (int k = 0; k < wall_contact_n[s]; ++k) wall(wall_contacts[s][k]);
+    for (int k = 0; k < wall_contact_n[s]; ++k) wall(wall_contacts_of(s)[k]);
 }
 
 void World::Impl::compute_forces(double hdt) {
@@ -660,7 +660,7 @@ void World::Impl::compute_forces(double hdt) {
       const int c = s_clump[s];
       const TypeData& ty = types[c_type[c]];
       for (int k = 0; k < n; ++k) {
-        WallContactData& wc = wall_contacts[s][k];
+        WallContactData& wc = wall_contacts[a][k];
         const WallData& wd = walls[wc.wall];
         const ResolvedContact& lw = law(ty.material, wd.material);
         const Eigen::Vector3d ri = wc.point - c_x[c];
@@ -728,9 +728,9 @@ void World::Impl::compute_forces(double hdt) {
 #pragma omp single nowait
     {
       for (int b = 0; b < nblocks; ++b) elastic += block_energy[b];
-      for (int s : wall_active)
-        for (int k = 0; k < wall_contact_n[s]; ++k) {
-          const WallContactData& wc = wall_contacts[s][k];
+      for (int a = 0; a < na; ++a)
+        for (int k = 0; k < wall_contact_n[wall_active[a]]; ++k) {
+          const WallContactData& wc = wall_contacts[a][k];
           WallData& wd = walls[wc.wall];
           const Eigen::Vector3d& f = wc.out.force;
           wd.state.force -= f;
@@ -806,10 +806,11 @@ void World::Impl::release_pinched(World& world) {
   }
   for (int s = 0; s < ns; ++s)
     for (int k = 0; k < wall_contact_n[s]; ++k) {
-      const double ratio = wall_contacts[s][k].overlap / s_r[s];
+      const double ratio = wall_contacts_of(s)[k].overlap / s_r[s];
       if (ratio <= settings.pinch_release) continue;
       if (ratio > first_ratio)
-        first_ratio = ratio, first = "against wall '" + walls[wall_contacts[s][k].wall].name + "'";
+        first_ratio = ratio,
+        first = "against wall '" + walls[wall_contacts_of(s)[k].wall].name + "'";
       out[s_clump[s]] = 1;
     }
   if (first.empty()) return;

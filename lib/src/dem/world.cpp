@@ -465,7 +465,7 @@ int World::Impl::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quat
     s_pos.push_back(p);
     s_pos_build.push_back(p);
     wall_slots.emplace_back();
-    wall_contacts.emplace_back();
+    wall_row.push_back(-1);  // a row in wall_contacts once wall_active is refreshed
     wall_contact_n.push_back(0);
     wall_cand_start.push_back(wall_cand_start.back());
   }
@@ -575,7 +575,8 @@ int World::remove_clumps(const std::function<bool(int)>& remove) {
   w.pair_live.clear();  // rebuilt from the histories at the next detection
   // Contacts of the last evaluation are dropped; wall candidates are rebuilt next step.
   w.pair_contacts.clear();
-  w.wall_contacts.assign(ks, {});
+  w.wall_contacts.clear();
+  w.wall_row.assign(ks, -1);
   w.wall_contact_n.assign(ks, 0);
   w.wall_cand.clear();
   w.wall_cand_start.assign(ks + 1, 0);
@@ -767,7 +768,7 @@ int World::contact_count() const {
   for (const auto& pc : impl_->pair_contacts) n += pc.closing ? 0 : 1;
   for (size_t s = 0; s < impl_->wall_contact_n.size(); ++s)
     for (int k = 0; k < impl_->wall_contact_n[s]; ++k)
-      n += impl_->wall_contacts[s][k].closing ? 0 : 1;
+      n += impl_->wall_contacts_of(static_cast<int>(s))[k].closing ? 0 : 1;
   return n;
 }
 
@@ -782,7 +783,7 @@ std::vector<ContactInfo> World::contacts() const {
   }
   for (size_t s = 0; s < w.wall_contact_n.size(); ++s)
     for (int k = 0; k < w.wall_contact_n[s]; ++k) {
-      const auto& wc = w.wall_contacts[s][k];
+      const auto& wc = w.wall_contacts_of(static_cast<int>(s))[k];
       if (wc.closing) continue;
       out.push_back({w.s_clump[s], -1, wc.wall, wc.point, wc.normal, wc.overlap, wc.out.force});
     }
