@@ -158,6 +158,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   w.s_pos.clear();
   w.s_pos_build.clear();
   w.wall_slots.clear();
+  w.wall_held.clear();
   w.wall_contacts.clear();
   w.wall_row.clear();
   w.wall_contact_n.clear();
@@ -182,6 +183,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   in.vec(w.wall_cand_start);
   in.vec(w.wall_cand);
   in.vec(w.wall_slots);
+  w.recount_wall_held();
   in.value(w.need_rebuild);
   w.wall_active_dirty = true;
   in.value(w.forces_valid);

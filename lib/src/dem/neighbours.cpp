@@ -284,8 +284,7 @@ void World::Impl::refresh_wall_active() {
   wall_active.clear();
   wall_row.assign(ns, -1);
   for (int s = 0; s < ns; ++s) {
-    bool held = false;
-    for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
+    const bool held = wall_held[s] != 0;
     // The rows move: every count is rewritten by the detection that follows.
     wall_contact_n[s] = 0;
     if (held || wall_cand_start[s] != wall_cand_start[s + 1]) {

@@ -401,8 +401,7 @@ void World::Impl::detect_contacts() {
     };
     // A slot not held (wall −1) is all zero (it was only ever written as such), so a sphere
     // that holds none and touches nothing has nothing to carry over or clear.
-    bool held = false;
-    for (const WallSlot& sl : wall_slots[s]) held = held || sl.wall >= 0;
+    const bool held = wall_held[s] != 0;
     if (!held && wall_cand_start[s] == wall_cand_start[s + 1]) {
       wall_contact_n[s] = 0;
       continue;
@@ -463,8 +462,8 @@ void World::Impl::detect_contacts() {
     }
     // Carry the history springs over: same wall, closest normal.
     auto& slots = wall_slots[s];
-    if (n == 1 && slots[0].wall == out[0].wall && slots[1].wall < 0 && slots[2].wall < 0 &&
-        slots[3].wall < 0 && slots[0].normal.dot(out[0].normal) > 0.5) {
+    if (n == 1 && wall_held[s] == 1 && slots[0].wall == out[0].wall &&
+        slots[0].normal.dot(out[0].normal) > 0.5) {
       // The usual case, one contact that goes on: what the general case below gives, in place.
       slots[0].normal = out[0].normal;
       out[0].closing = false;
@@ -505,6 +504,7 @@ void World::Impl::detect_contacts() {
         ++n;
       }
     wall_slots[s] = next;
+    wall_held[s] = static_cast<std::uint8_t>((1u << n) - 1u);  // next holds slots 0 … n − 1
     wall_contact_n[s] = n;
   }
   for (int a = 0; a < na; ++a) {

@@ -465,6 +465,7 @@ int World::Impl::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quat
     s_pos.push_back(p);
     s_pos_build.push_back(p);
     wall_slots.emplace_back();
+    wall_held.push_back(0);
     wall_row.push_back(-1);  // a row in wall_contacts once wall_active is refreshed
     wall_contact_n.push_back(0);
     wall_cand_start.push_back(wall_cand_start.back());
@@ -559,6 +560,7 @@ int World::remove_clumps(const std::function<bool(int)>& remove) {
   compact(w.s_pos, sphere_map);
   compact(w.s_pos_build, sphere_map);
   compact(w.wall_slots, sphere_map);
+  w.recount_wall_held();
   w.c_first.assign(kept, 0);
   for (int s = ks - 1; s >= 0; --s) w.c_first[w.s_clump[s]] = s;
   // Pair lists stay sorted under the monotone renumbering.

@@ -151,6 +151,16 @@ struct World::Impl {
   std::vector<std::vector<std::pair<std::uint64_t, int>>> tri_bins;
   bool tri_bins_valid = false;
   std::vector<std::array<WallSlot, kWallSlots>> wall_slots;
+  // Per sphere, bit k set if wall_slots[s][k] is held (wall >= 0): the detection reads this
+  // byte instead of the four slots (~350 bytes) of every sphere near a wall. Kept with the
+  // slots (detect_contacts, add_clump); recount_wall_held after they are replaced wholesale.
+  std::vector<std::uint8_t> wall_held;
+  void recount_wall_held() {
+    wall_held.assign(wall_slots.size(), 0);
+    for (size_t s = 0; s < wall_slots.size(); ++s)
+      for (int k = 0; k < kWallSlots; ++k)
+        if (wall_slots[s][k].wall >= 0) wall_held[s] |= std::uint8_t(1u << k);
+  }
   // Spheres with wall candidates or a wall contact history, ascending: the only spheres the
   // wall stages visit. Refreshed at every rebuild and whenever marked dirty (clumps added or
   // removed, a checkpoint loaded).
