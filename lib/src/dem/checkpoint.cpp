@@ -252,6 +252,7 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   // The contacts of the saved step are re-detected (detection is a pure function of positions
   // and histories are already restored): nothing else needs them before the next force pass.
   w.pair_contacts.clear();
+  w.pair_contact_clumps.clear();
 }
 
 }  // namespace clumpkit::dem

@@ -348,12 +348,14 @@ void World::Impl::detect_contacts() {
     {
       for (int u = 0; u < nt; ++u) offset[u + 1] += offset[u];
       if (pair_contacts.size() < offset[nt]) pair_contacts.resize(offset[nt]);
+      pair_contact_clumps.resize(offset[nt]);
     }
     double best = 0.0;
     int best_k = -1;
     size_t o = offset[t];
     for (const auto& [k, sd] : touch) {
       const PairEntry& p = pairs[k];
+      pair_contact_clumps[o] = {s_clump[p.i], s_clump[p.j]};
       PairContactData& pc = pair_contacts[o++];
       const double rr = s_r[p.i] + s_r[p.j];
       const double d = std::abs(sd);
@@ -570,8 +572,8 @@ void World::Impl::compute_forces(double hdt) {
   j_start.resize(nc + 1);
   j_list.resize(npc);
   j_count.resize(nt_all);
-  auto clump_i = [&](int k) { return s_clump[pairs[pair_contacts[k].pair].i]; };
-  auto clump_j = [&](int k) { return s_clump[pairs[pair_contacts[k].pair].j]; };
+  auto clump_i = [&](int k) { return pair_contact_clumps[k][0]; };
+  auto clump_j = [&](int k) { return pair_contact_clumps[k][1]; };
   // One parallel region: clump kinematics and the contact index, the pair and wall laws, then
   // the sums. The laws and the sums are shared out dynamically (the cost per contact and per
   // clump varies along the lists: jammed clumps at the bottom of a bed need the implicit
@@ -624,7 +626,7 @@ void World::Impl::compute_forces(double hdt) {
       for (int k = b * kBlock; k < std::min(npc, (b + 1) * kBlock); ++k) {
         PairContactData& pc = pair_contacts[k];
         const PairEntry& p = pairs[pc.pair];
-        const int ci = s_clump[p.i], cj = s_clump[p.j];
+        const int ci = pair_contact_clumps[k][0], cj = pair_contact_clumps[k][1];
         const TypeData& ti = types[c_type[ci]];
         const TypeData& tj = types[c_type[cj]];
         const ResolvedContact& lw = law(ti.material, tj.material);

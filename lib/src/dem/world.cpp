@@ -577,6 +577,7 @@ int World::remove_clumps(const std::function<bool(int)>& remove) {
   w.pair_live.clear();  // rebuilt from the histories at the next detection
   // Contacts of the last evaluation are dropped; wall candidates are rebuilt next step.
   w.pair_contacts.clear();
+  w.pair_contact_clumps.clear();
   w.wall_contacts.clear();
   w.wall_row.assign(ks, -1);
   w.wall_contact_n.assign(ks, 0);

@@ -187,6 +187,9 @@ struct World::Impl {
 
   // Contacts of the current step.
   std::vector<PairContactData> pair_contacts;
+  // The two clumps of each pair contact (i's, j's), beside the list: the forces' index reads
+  // them for every contact, and a PairContactData is ~230 bytes.
+  std::vector<std::array<int, 2>> pair_contact_clumps;
   // Wall contacts of the current step, one row per sphere of wall_active (the only spheres
   // that can have any): a row per sphere made this a ~1 kB stride over every sphere, 40 MB at
   // paper scale, which the wall stages walked through cache-missing. wall_row[s] is sphere s's
