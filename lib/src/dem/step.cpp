@@ -214,18 +214,12 @@ void World::Impl::kick_and_drift() {
 #pragma omp for schedule(static) nowait
     for (int c = 0; c < nc; ++c) {
       // The clump's spheres (contiguous).
-      // x + R o written out: Eigen called its generic product kernel once per sphere. The sums
-      // are associated as Eigen's x + R * o does (rows 0 and 1 as (a + b) + c, row 2 as
-      // a + (b + c)), so the positions keep their bits.
       const Eigen::Vector3d x = c_x[c];
       const Eigen::Matrix3d R = c_R[c];
       double dc = 0.0;
       const int s1 = sphere_end(c);
       for (int s = c_first[c]; s < s1; ++s) {
-        const Eigen::Vector3d& o = s_off[s];
-        const Eigen::Vector3d p(x.x() + ((R(0, 0) * o.x() + R(0, 1) * o.y()) + R(0, 2) * o.z()),
-                                x.y() + ((R(1, 0) * o.x() + R(1, 1) * o.y()) + R(1, 2) * o.z()),
-                                x.z() + (R(2, 0) * o.x() + (R(2, 1) * o.y() + R(2, 2) * o.z())));
+        const Eigen::Vector3d p = sphere_position(x, R, s_off[s]);
         s_pos[s] = p;
         dc = std::max(dc, (p - s_pos_build[s]).squaredNorm());
       }

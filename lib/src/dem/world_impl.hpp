@@ -273,6 +273,17 @@ struct World::Impl {
   std::uint64_t compute_fingerprint() const;
 };
 
+/// x + R o, the position of a sphere at body offset o, written out: Eigen's `x + R * o` called
+/// its generic product kernel once per sphere. Associated as Eigen associates it (rows 0 and 1
+/// as (a + b) + c, row 2 as a + (b + c); checked by DemKernels.SpherePositionIsEigensProduct),
+/// so positions keep their bits.
+inline Eigen::Vector3d sphere_position(const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
+                                       const Eigen::Vector3d& o) {
+  return {x.x() + ((R(0, 0) * o.x() + R(0, 1) * o.y()) + R(0, 2) * o.z()),
+          x.y() + ((R(1, 0) * o.x() + R(1, 1) * o.y()) + R(1, 2) * o.z()),
+          x.z() + (R(2, 0) * o.x() + (R(2, 1) * o.y() + R(2, 2) * o.z()))};
+}
+
 /// Whether a contact history holds anything (springs or a pending damping impulse).
 inline bool history_empty(const ContactHistory& h) {
   return h.damping == 0.0 && h.shear.isZero(0.0) && h.roll.isZero(0.0);
