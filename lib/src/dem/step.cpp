@@ -129,7 +129,7 @@ void World::Impl::update_spheres(int first_clump) {
 #pragma omp parallel for num_threads(threads) schedule(static) if (ns - n0 >= kParallelMin)
   for (int s = n0; s < ns; ++s) {
     const int c = s_clump[s];
-    s_pos[s] = c_x[c] + c_R[c] * s_off[s];
+    s_pos[s] = sphere_position(c_x[c], c_R[c], s_off[s]);
   }
 }
 
@@ -395,13 +395,6 @@ void World::Impl::detect_contacts() {
       int wall, tri;
       Eigen::Vector3d point;
     };
-    // A slot not held (wall −1) is all zero (it was only ever written as such), so a sphere
-    // that holds none and touches nothing has nothing to carry over or clear.
-    const bool held = wall_held[s] != 0;
-    if (!held && wall_cand_start[s] == wall_cand_start[s + 1]) {
-      wall_contact_n[s] = 0;
-      continue;
-    }
     Cand cands[32];
     int nc = 0;
     const Eigen::Vector3d& p = s_pos[s];
@@ -417,7 +410,9 @@ void World::Impl::detect_contacts() {
       const double d = (p - c).norm();
       if (d < r) cands[nc++] = {d, wi, ti, c};
     }
-    if (nc == 0 && !held) {  // the usual case: candidates within the skin, none touching
+    // The usual case: nothing touching and no contact held. A slot not held (wall −1) is all
+    // zero (it is only ever written as such), so there is nothing to carry over or clear.
+    if (nc == 0 && wall_held[s] == 0) {
       wall_contact_n[s] = 0;
       continue;
     }
@@ -468,38 +463,37 @@ void World::Impl::detect_contacts() {
     }
     std::array<WallSlot, kWallSlots> next{};
     std::array<bool, kWallSlots> used{};
-    const auto& prev = wall_slots[s];
     for (int k = 0; k < n; ++k) {
       int best = -1;
       double best_dot = 0.5;
       for (int j = 0; j < kWallSlots; ++j)
-        if (!used[j] && prev[j].wall == out[k].wall) {
-          const double dd = prev[j].normal.dot(out[k].normal);
+        if (!used[j] && slots[j].wall == out[k].wall) {
+          const double dd = slots[j].normal.dot(out[k].normal);
           if (dd > best_dot) best_dot = dd, best = j;
         }
       next[k].wall = out[k].wall;
       next[k].normal = out[k].normal;
       if (best >= 0) {
         used[best] = true;
-        next[k].history = prev[best].history;
+        next[k].history = slots[best].history;
       }
       out[k].closing = false;
     }
     // Contacts that ended during the step and still owe their last damping impulse.
     for (int j = 0; j < kWallSlots && n < kWallSlots; ++j)
-      if (!used[j] && prev[j].wall >= 0 && prev[j].history.damping != 0.0) {
+      if (!used[j] && slots[j].wall >= 0 && slots[j].history.damping != 0.0) {
         WallContactData& wc = out[n];
-        wc.wall = prev[j].wall;
-        wc.normal = prev[j].normal;
-        wc.point = p - r * prev[j].normal;
+        wc.wall = slots[j].wall;
+        wc.normal = slots[j].normal;
+        wc.point = p - r * slots[j].normal;
         wc.overlap = 0.0;
         wc.closing = true;
-        next[n].wall = prev[j].wall;
-        next[n].normal = prev[j].normal;
-        next[n].history = prev[j].history;
+        next[n].wall = slots[j].wall;
+        next[n].normal = slots[j].normal;
+        next[n].history = slots[j].history;
         ++n;
       }
-    wall_slots[s] = next;
+    slots = next;
     wall_held[s] = static_cast<std::uint8_t>((1u << n) - 1u);  // next holds slots 0 … n − 1
     wall_contact_n[s] = n;
   }

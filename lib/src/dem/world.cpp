@@ -461,7 +461,7 @@ int World::Impl::add_clump(int type, const Eigen::Vector3d& x, const Eigen::Quat
     s_clump.push_back(c);
     s_r.push_back(t.radii[k]);
     s_off.push_back(t.offsets[k]);
-    const Eigen::Vector3d p = x + c_R.back() * t.offsets[k];
+    const Eigen::Vector3d p = sphere_position(x, c_R.back(), t.offsets[k]);
     s_pos.push_back(p);
     s_pos_build.push_back(p);
     wall_slots.emplace_back();
