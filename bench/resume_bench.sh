@@ -30,6 +30,12 @@ one() {
   cp "$ckpt" "$run_dir/repeat_1/state.json" "$d/repeat_1/"
   "$bin" rig "$@" --threads "$threads" --out "$d" --json "$d.json" >/dev/null 2>"$d.log" || {
     echo "$bin failed: see $d.log" >&2; return 1; }
+  # A binary built by bench/segment_bench.sh stops after a number of steps and prints its
+  # stage times instead of finishing the run.
+  if grep -q '^SEGMENT' "$d.log"; then
+    sed -n '/^SEGMENT/,$p' "$d.log" | sed "s|^|$bin: |"
+    return
+  fi
   python3 - "$d.json" "$bin" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

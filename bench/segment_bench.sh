@@ -12,7 +12,7 @@
 # e.g. "angle_of_repose --model production --scale paper".
 #
 # Each REV is built (Release, as bench/../CMakeLists.txt builds it) in a temporary worktree
-# with one addition, bench/segment_stop.py: after STEPS steps of a World, print the stage
+# with one addition, bench/segment_stop.py, and run by bench/resume_bench.sh: after STEPS steps of a World, print the stage
 # times and the state hash, time each stage 300 more times on that state (minimum, quartile,
 # median per call) and exit. Same STEPS from the same checkpoint give the same hash for any
 # commit that keeps the engine's bits. THREADS (default 1) sets --threads; SIDE_BY_SIDE=0
@@ -28,33 +28,26 @@ while [ "$#" -gt 0 ] && [ "$1" != "--" ]; do revs+=("$1"); shift; done
   { echo "usage: $0 SNAPSHOT STEPS ROUNDS REV [REV ...] -- RIG ARGS" >&2; exit 2; }
 shift
 [ -d "$snap/repeat_1" ] || { echo "$snap: no repeat_1/ with a checkpoint" >&2; exit 2; }
-threads=${THREADS:-1}
 work=$(mktemp -d)
 cleanup() {
   for k in "${!revs[@]}"; do git -C "$repo" worktree remove --force "$work/src$k" 2>/dev/null || true; done
   rm -rf "$work"
 }
 trap cleanup EXIT
+bins=()
 for k in "${!revs[@]}"; do
   git -C "$repo" worktree add -q --detach "$work/src$k" "${revs[$k]}"
   python3 "$here/segment_stop.py" "$work/src$k/lib/src/dem/step.cpp"
   cmake -S "$work/src$k" -B "$work/build$k" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_UNITY_BUILD=ON >/dev/null
   cmake --build "$work/build$k" -j2 --target clumpkit >/dev/null
+  mkdir -p "$work/bin$k"
+  ln -s "$work/build$k/apps/clumpkit/clumpkit" "$work/bin$k/${revs[$k]}"  # labels the output
+  bins+=("$work/bin$k/${revs[$k]}")
   echo "built ${revs[$k]}" >&2
 done
-one() {
-  local k=$1 d="$work/run$1.$2"
-  shift 2
-  mkdir -p "$d"
-  cp -r "$snap" "$d/run"
-  CLUMPKIT_SEGMENT_STEPS=$steps "$work/build$k/apps/clumpkit/clumpkit" rig "$@" --threads "$threads" \
-    --out "$d/run" --json "$d/r.json" 2>&1 | sed -n '/^SEGMENT/,$p' | sed "s|^|${revs[$k]}: |"
-  rm -rf "$d"
-}
+# The runs themselves are bench/resume_bench.sh's, with the stop switched on.
+export CLUMPKIT_SEGMENT_STEPS=$steps SIDE_BY_SIDE=${SIDE_BY_SIDE:-1}
 for r in $(seq "$rounds"); do
-  for k in "${!revs[@]}"; do
-    if [ "${SIDE_BY_SIDE:-1}" = 1 ]; then one "$k" "$r" "$@" & else one "$k" "$r" "$@"; fi
-  done
-  wait
+  "$here/resume_bench.sh" "$snap" "${THREADS:-1}" "${bins[@]}" -- "$@"
 done
