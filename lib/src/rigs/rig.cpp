@@ -697,27 +697,46 @@ RepeatResult angle_of_repose(Ctx& c) {
   double t_lift = state.at("t_lift_end");
   double lift = state.at("lift_m");
   const double t_on = state.at("t_action");
+  // Consecutive lift checks with the heap at rest (the settle criterion); kept in the state, so
+  // a resumed lift stops where an uninterrupted one does.
+  int quiet = state.value("lift_quiet", 0);
   while (w.time() < t_lift) {
     w.run_until(std::min(t_lift, w.time() + 0.02));
     cull(c, w);
     // The tube has done its job once its bottom edge is a pill diameter above every pill inside
     // or below its footprint: it stops there instead of rising over the whole initial bed (the
-    // bed slumps as the tube rises, so this saves about half of the lift).
+    // bed slumps as the tube rises, so this saves about half of the lift). It has done it too
+    // once the heap is at rest (the settle criterion, on two checks 0.02 s apart) with no pill
+    // within half a bounding radius of reach of its shell: nothing the tube does from there on
+    // moves a pill (paper scale: the heap was at rest for the last ~2.8 s of a 71.5 mm lift while
+    // the edge rose over the apex).
     if (p.lift_height <= 0 && w.time() < t_lift) {
       const double bottom = p.lift_speed * (w.time() - t_on);
-      bool touching = false;
+      const double reach = 1.5 * br;
+      bool touching = false, near_shell = false;
       for (int i = 0; i < w.clump_count() && !touching; ++i) {
         const Vector3d& x = w.positions()[i];
-        touching = x.head<2>().norm() < R + br && x.z() + 3.0 * br > bottom;
+        const double rho = x.head<2>().norm();
+        touching = rho < R + br && x.z() + 3.0 * br > bottom;
+        near_shell = near_shell || (std::abs(rho - R) < reach && x.z() + reach > bottom &&
+                                    x.z() - reach < bottom + g.height);
       }
-      if (!touching) {
+      quiet = rms_speed(w) < p.settle_speed ? quiet + 1 : 0;
+      const bool at_rest = quiet >= 2 && !near_shell;
+      if (!touching || at_rest) {
         t_lift = w.time();
         lift = bottom;
         w.set_wall_motion(tube_wall, tube(t_on, t_lift).motion);
         state["t_lift_end"] = t_lift, state["lift_m"] = lift;
+        state["lift_stop"] = touching ? "heap at rest, clear of the shell" : "cleared the heap";
         keep_checkpoint(c, w, 2, state, true);
-        c.say(fmt::format("the tube cleared the heap after a {:.1f} mm lift", 1e3 * lift));
+        c.say(touching
+                  ? fmt::format("the heap is at rest and clear of the tube's shell after a "
+                                "{:.1f} mm lift: the tube stops there",
+                                1e3 * lift)
+                  : fmt::format("the tube cleared the heap after a {:.1f} mm lift", 1e3 * lift));
       }
+      state["lift_quiet"] = quiet;
     }
     keep_checkpoint(c, w, 2, state, false);
     c.progress([&] {
@@ -756,6 +775,7 @@ RepeatResult angle_of_repose(Ctx& c) {
                {"pills", w.clump_count()},
                {"mass_kg", w.total_mass()},
                {"lift_m", lift},
+               {"lift_stop", state.value("lift_stop", "")},
                {"settle_fill", state["settle_fill"]},
                {"fill", state.value("fill", nlohmann::json::object())},
                {"settle_heap", settle_json(s2)},
