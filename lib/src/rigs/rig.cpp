@@ -697,6 +697,9 @@ RepeatResult angle_of_repose(Ctx& c) {
   double t_lift = state.at("t_lift_end");
   double lift = state.at("lift_m");
   const double t_on = state.at("t_action");
+  // The state names the tube's motion: a resumed run sets it from there (the same motion the
+  // checkpoint carries, unless the state was edited to go on lifting).
+  w.set_wall_motion(tube_wall, tube(t_on, t_lift).motion);
   // Consecutive lift checks with the heap at rest (the settle criterion); kept in the state, so
   // a resumed lift stops where an uninterrupted one does.
   int quiet = state.value("lift_quiet", 0);
@@ -707,17 +710,18 @@ RepeatResult angle_of_repose(Ctx& c) {
     // or below its footprint: it stops there instead of rising over the whole initial bed (the
     // bed slumps as the tube rises, so this saves about half of the lift). It has done it too
     // once the heap is at rest (the settle criterion, on two checks 0.02 s apart) with no pill
-    // within half a bounding radius of reach of its shell: nothing the tube does from there on
-    // moves a pill (paper scale: the heap was at rest for the last ~2.8 s of a 71.5 mm lift while
-    // the edge rose over the apex).
+    // within 1.5 bounding radii of its shell: nothing the tube does from there on moves a pill
+    // (paper scale: the heap was at rest for the last ~2.8 s of a 71.5 mm lift while the edge
+    // rose over the apex).
     if (p.lift_height <= 0 && w.time() < t_lift) {
       const double bottom = p.lift_speed * (w.time() - t_on);
       const double reach = 1.5 * br;
       bool touching = false, near_shell = false;
-      for (int i = 0; i < w.clump_count() && !touching; ++i) {
+      // Every pill is looked at until both are known (the pill that touches may come first).
+      for (int i = 0; i < w.clump_count() && !(touching && near_shell); ++i) {
         const Vector3d& x = w.positions()[i];
         const double rho = x.head<2>().norm();
-        touching = rho < R + br && x.z() + 3.0 * br > bottom;
+        touching = touching || (rho < R + br && x.z() + 3.0 * br > bottom);
         near_shell = near_shell || (std::abs(rho - R) < reach && x.z() + reach > bottom &&
                                     x.z() - reach < bottom + g.height);
       }
