@@ -73,5 +73,33 @@ TEST(RigGeometry, MeshesAreValidAndPlaced) {
   EXPECT_NO_THROW(plate_mesh(l).validate("plate", "mesh"));
 }
 
+// The lift's stop rules read every pill: a pill in the tube's footprint listed before one at
+// the shell must not hide it (session 21's paper-scale run stopped the tube after 14 mm with the
+// column standing when the scan ended at the first pill in the footprint).
+TEST(RigGeometry, TubeClearanceLooksAtEveryPill) {
+  const double R = 0.03, br = 0.004, bottom = 0.02, height = 0.15;
+  const Eigen::Vector3d axis_top(0, 0, 0.05);          // under the tube, far from the shell
+  const Eigen::Vector3d at_shell(R - 0.003, 0, 0.03);  // against the shell, above the edge
+  const Eigen::Vector3d below(R, 0, bottom - 0.01);   // at the shell's radius, 10 mm below the edge
+  const Eigen::Vector3d outside(R + 0.02, 0, 0.005);  // on the flank, outside
+  TubeClearance c = tube_clearance({axis_top, at_shell}, R, br, bottom, height);
+  EXPECT_TRUE(c.in_footprint);
+  EXPECT_TRUE(c.near_shell);
+  c = tube_clearance({axis_top, below, outside}, R, br, bottom, height);
+  EXPECT_TRUE(c.in_footprint);  // the apex is under the tube
+  EXPECT_FALSE(c.near_shell);   // 10 mm below the edge is beyond 1.5 br = 6 mm
+  c = tube_clearance({below, outside}, R, br, bottom, height);
+  EXPECT_FALSE(c.near_shell);
+  EXPECT_TRUE(c.in_footprint);  // 3 br = 12 mm: the clearing rule still waits for it
+  c = tube_clearance({outside, Eigen::Vector3d(0, 0, bottom - 0.02)}, R, br, bottom, height);
+  EXPECT_FALSE(c.in_footprint);
+  EXPECT_FALSE(c.near_shell);
+  // Above the tube's top, beyond the reach: not near the shell.
+  c = tube_clearance({Eigen::Vector3d(R, 0, bottom + height + 0.007)}, R, br, bottom, height);
+  EXPECT_FALSE(c.near_shell);
+  c = tube_clearance({Eigen::Vector3d(R, 0, bottom + height + 0.005)}, R, br, bottom, height);
+  EXPECT_TRUE(c.near_shell);
+}
+
 }  // namespace
 }  // namespace clumpkit::rigs

@@ -88,6 +88,21 @@ dem::TriangleMesh lifting_cylinder_mesh(const LiftingGeometry& g) {
   return tube(0.5 * g.inner_diameter, 0.0, g.height, g.segments, true);
 }
 
+TubeClearance tube_clearance(const std::vector<Vector3d>& centres, double radius, double br,
+                             double bottom, double height) {
+  TubeClearance c;
+  const double reach = 1.5 * br;
+  // Every centre is looked at until both are known (a pill in the footprint may come first).
+  for (size_t i = 0; i < centres.size() && !(c.in_footprint && c.near_shell); ++i) {
+    const Vector3d& x = centres[i];
+    const double rho = x.head<2>().norm();
+    c.in_footprint = c.in_footprint || (rho < radius + br && x.z() + 3.0 * br > bottom);
+    c.near_shell = c.near_shell || (std::abs(rho - radius) < reach && x.z() + reach > bottom &&
+                                    x.z() - reach < bottom + height);
+  }
+  return c;
+}
+
 dem::TriangleMesh plate_mesh(const LiftingGeometry& g) {
   return dem::make_plane(Vector3d::Zero(), Vector3d::UnitZ(), g.plate_side, g.plate_side, 1);
 }

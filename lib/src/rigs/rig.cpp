@@ -715,18 +715,10 @@ RepeatResult angle_of_repose(Ctx& c) {
     // rose over the apex).
     if (p.lift_height <= 0 && w.time() < t_lift) {
       const double bottom = p.lift_speed * (w.time() - t_on);
-      const double reach = 1.5 * br;
-      bool touching = false, near_shell = false;
-      // Every pill is looked at until both are known (the pill that touches may come first).
-      for (int i = 0; i < w.clump_count() && !(touching && near_shell); ++i) {
-        const Vector3d& x = w.positions()[i];
-        const double rho = x.head<2>().norm();
-        touching = touching || (rho < R + br && x.z() + 3.0 * br > bottom);
-        near_shell = near_shell || (std::abs(rho - R) < reach && x.z() + reach > bottom &&
-                                    x.z() - reach < bottom + g.height);
-      }
+      const TubeClearance tc = tube_clearance(w.positions(), R, br, bottom, g.height);
+      const bool touching = tc.in_footprint;
       quiet = rms_speed(w) < p.settle_speed ? quiet + 1 : 0;
-      const bool at_rest = quiet >= 2 && !near_shell;
+      const bool at_rest = quiet >= 2 && !tc.near_shell;
       if (!touching || at_rest) {
         t_lift = w.time();
         lift = bottom;

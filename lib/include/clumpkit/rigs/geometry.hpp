@@ -39,6 +39,19 @@ struct LiftingGeometry {
 dem::TriangleMesh lifting_cylinder_mesh(const LiftingGeometry& g);
 dem::TriangleMesh plate_mesh(const LiftingGeometry& g);
 
+/// Where the pills stand against the lifting tube (inner radius `radius`, its bottom edge at
+/// `bottom`, `height` tall), from the clumps' centres and their largest bounding radius `br`.
+struct TubeClearance {
+  /// Some centre within `radius + br` of the axis lies less than 3 br below the bottom edge or
+  /// above it: the tube has not yet cleared the heap.
+  bool in_footprint = false;
+  /// Some centre lies within 1.5 br of the shell radially, at a height within 1.5 br of the
+  /// tube's extent: the tube may touch it.
+  bool near_shell = false;
+};
+TubeClearance tube_clearance(const std::vector<Eigen::Vector3d>& centres, double radius, double br,
+                             double bottom, double height);
+
 /// Discharge rig: a pocket wheel turning about the y axis, fed from a hopper above and closed
 /// by a housing around its upper half-turn; pills leave through the open lower side.
 /// The rig is a slice of `length` along the wheel axis (y ∈ ±length/2) between two end plates;
