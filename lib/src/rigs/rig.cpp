@@ -771,7 +771,7 @@ RepeatResult angle_of_repose(Ctx& c) {
                {"pills", w.clump_count()},
                {"mass_kg", w.total_mass()},
                {"lift_m", lift},
-               {"lift_stop", state.value("lift_stop", "")},
+               {"lift_stop", state.value("lift_stop", "full lift")},
                {"settle_fill", state["settle_fill"]},
                {"fill", state.value("fill", nlohmann::json::object())},
                {"settle_heap", settle_json(s2)},
