@@ -697,8 +697,8 @@ RepeatResult angle_of_repose(Ctx& c) {
   double t_lift = state.at("t_lift_end");
   double lift = state.at("lift_m");
   const double t_on = state.at("t_action");
-  // The state names the tube's motion: a resumed run sets it from there (the same motion the
-  // checkpoint carries, unless the state was edited to go on lifting).
+  // The state is the source of the tube's motion (t_action, t_lift_end); a resumed run sets it
+  // from there.
   w.set_wall_motion(tube_wall, tube(t_on, t_lift).motion);
   // Consecutive lift checks with the heap at rest (the settle criterion); kept in the state, so
   // a resumed lift stops where an uninterrupted one does.
@@ -711,22 +711,20 @@ RepeatResult angle_of_repose(Ctx& c) {
     // bed slumps as the tube rises, so this saves about half of the lift). It has done it too
     // once the heap is at rest (the settle criterion, on two checks 0.02 s apart) with no pill
     // within 1.5 bounding radii of its shell: nothing the tube does from there on moves a pill
-    // (paper scale: the heap was at rest for the last ~2.8 s of a 71.5 mm lift while the edge
-    // rose over the apex).
+    // (paper scale, session 21: a 60.4 mm lift ending at 22.84 s instead of 71.5 mm at 26.18 s).
     if (p.lift_height <= 0 && w.time() < t_lift) {
       const double bottom = p.lift_speed * (w.time() - t_on);
       const TubeClearance tc = tube_clearance(w.positions(), R, br, bottom, g.height);
-      const bool touching = tc.in_footprint;
       quiet = rms_speed(w) < p.settle_speed ? quiet + 1 : 0;
-      const bool at_rest = quiet >= 2 && !tc.near_shell;
-      if (!touching || at_rest) {
+      if (!tc.in_footprint || (quiet >= 2 && !tc.near_shell)) {
         t_lift = w.time();
         lift = bottom;
         w.set_wall_motion(tube_wall, tube(t_on, t_lift).motion);
         state["t_lift_end"] = t_lift, state["lift_m"] = lift;
-        state["lift_stop"] = touching ? "heap at rest, clear of the shell" : "cleared the heap";
+        state["lift_stop"] =
+            tc.in_footprint ? "heap at rest, clear of the shell" : "cleared the heap";
         keep_checkpoint(c, w, 2, state, true);
-        c.say(touching
+        c.say(tc.in_footprint
                   ? fmt::format("the heap is at rest and clear of the tube's shell after a "
                                 "{:.1f} mm lift: the tube stops there",
                                 1e3 * lift)
