@@ -176,6 +176,157 @@ TEST_F(MeshFiles, PlyCountsThatDoNotMatchTheBodyAreRefusedWithTheirPlace) {
   refused("float_count.ply", float_count, "integer type");
 }
 
+// The input on which CI's fuzzer made assimp 5.2 ask for 96 GB: a valid PLY whose comment line
+// follows a longer obj_info line. assimp's parser re-read the stale tail of the obj_info line
+// ("element edge 4294967295") as an element; clumpkit's own reader reads it as the tetrahedron
+// it is (tests/fuzz/regressions/mesh_file/ply_stale_header_bytes_assimp_oom.ply).
+TEST_F(MeshFiles, PlyCommentsAndObjInfoAreOnlyComments) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nobj_info zzzzzz element edge 4294967295\ncomment abcdefg\n"
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\n"
+      "property list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  MeshReport r;
+  const TriangleMesh m = load_mesh(write("tet.ply", ply), MeshLoadOptions{}, &r);
+  EXPECT_EQ(m.vertices.size(), 4u);
+  EXPECT_EQ(m.triangles.size(), 4u);
+  EXPECT_TRUE(r.closed_solid()) << r.defects();
+  EXPECT_NEAR(polyhedron_moments(m).m0, 1.0 / 6.0, 1e-12);
+}
+
+// What real exporters write beyond the cube: extra vertex properties (normals, colours) in any
+// order, other elements, quads, CRLF line ends, a tristrips element instead of faces.
+TEST_F(MeshFiles, PlyExtraPropertiesElementsQuadsAndStripsLoad) {
+  const TriangleMesh b = box_mesh(Eigen::Vector3d(1, 1, 1));
+  std::string t =
+      "ply\r\nformat ascii 1.0\r\ncomment made by a scanner\r\nelement vertex 8\r\n"
+      "property double nx\r\nproperty float z\r\nproperty uchar red\r\nproperty float x\r\n"
+      "property float y\r\nelement face 12\r\nproperty uchar flags\r\n"
+      "property list uint8 int32 vertex_index\r\nproperty list uchar float texcoord\r\n"
+      "element material 1\r\nproperty float shine\r\nend_header\r\n";
+  for (const auto& v : b.vertices)
+    t += "0.5 " + std::to_string(v[2]) + " 255 " + std::to_string(v[0]) + " " +
+         std::to_string(v[1]) + "\r\n";
+  for (const auto& f : b.triangles)
+    t += "7 3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) +
+         " 2 0.25 0.5\r\n";
+  t += "30\r\n";
+  MeshReport r;
+  TriangleMesh m = load_mesh(write("extra.ply", t), MeshLoadOptions{}, &r);
+  EXPECT_EQ(m.triangles.size(), 12u);
+  EXPECT_TRUE(r.closed_solid()) << r.defects();
+  EXPECT_NEAR(polyhedron_moments(m).m0, 1.0, 1e-12);
+
+  // A square pyramid: the base a quad, the sides one strip with a restart.
+  const std::string pyramid =
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 3 2 1\n9 0 1 4 2 3 -1 3 0 4\n";
+  m = load_mesh(write("pyramid.ply", pyramid), MeshLoadOptions{}, &r);
+  EXPECT_EQ(m.triangles.size(), 6u);
+  EXPECT_TRUE(r.closed_solid()) << r.defects();
+  EXPECT_NEAR(polyhedron_moments(m).m0, 1.0 / 3.0, 1e-12);
+}
+
+TEST_F(MeshFiles, PlyHeadersThatDoNotDescribeAMeshAreRefusedWithTheirLine) {
+  const auto refused = [&](const std::string& name, const std::string& text,
+                           const std::string& expected) {
+    SCOPED_TRACE(name);
+    try {
+      load_mesh(write(name, text));
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  const std::string ascii = cube_ply();
+  std::string no_z = ascii;
+  no_z.replace(no_z.find("float z"), 7, "float w");
+  refused("no_z.ply", no_z, "line 3: PLY 'vertex' element without x, y and z");
+  std::string no_list = ascii;
+  no_list.replace(no_list.find("vertex_indices"), 14, "corners");
+  refused("no_list.ply", no_list, "line 7: PLY 'face' element without a vertex_indices list");
+  std::string twice = ascii;
+  twice.replace(twice.find("element face"), 12, "element vertex");
+  refused("twice.ply", twice, "line 7: malformed PLY header (a second 'vertex' element)");
+  std::string unnamed = ascii;
+  unnamed.replace(unnamed.find("property float y"), 16, "property float");
+  refused("unnamed.ply", unnamed, "line 5: malformed PLY header (expected 'property TYPE NAME')");
+  std::string index = ascii;
+  index.replace(index.rfind("\n3 ") + 1, 7, "3 0 1 8");
+  refused("index.ply", index,
+          "line 29: malformed PLY body ('face' element): vertex index 8 names "
+          "no vertex (the file has 8)");
+  refused("no_vertex.ply",
+          "ply\nformat ascii 1.0\nelement point 1\nproperty float x\nend_header\n1\n",
+          "without a 'vertex' element");
+  refused("magic.ply", "plyx\nformat ascii 1.0\n", "line 1: not a PLY file");
+}
+
+TEST_F(MeshFiles, OffVariantsLoadAndDefectsNameTheirLine) {
+  const TriangleMesh b = box_mesh(Eigen::Vector3d(1, 1, 1));
+  // COFF: colours after each vertex and face; counts on the header line; comments, blank lines.
+  std::string t = "# a comment first\nCOFF 8 12 18 # counts\n\n";
+  for (const auto& v : b.vertices)
+    t += std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) +
+         " 255 0 0 255\n";
+  for (const auto& f : b.triangles)
+    t += "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) +
+         " 0.1 0.2 0.3  # rgb\n";
+  MeshReport r;
+  const TriangleMesh m = load_mesh(write("c.off", t), MeshLoadOptions{}, &r);
+  EXPECT_EQ(m.triangles.size(), 12u);
+  EXPECT_TRUE(r.closed_solid()) << r.defects();
+  EXPECT_NEAR(polyhedron_moments(m).m0, 1.0, 1e-12);
+  // A quad face is fanned.
+  const std::string pyramid =
+      "OFF\n5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 3 2 1\n"
+      "3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n";
+  EXPECT_NEAR(polyhedron_moments(load_mesh(write("p.off", pyramid))).m0, 1.0 / 3.0, 1e-12);
+
+  const auto refused = [&](const std::string& name, const std::string& text,
+                           const std::string& expected) {
+    SCOPED_TRACE(name);
+    try {
+      load_mesh(write(name, text));
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  const std::string off = cube_off();
+  std::string index = off;
+  index.replace(index.rfind("\n3 ") + 1, 7, "3 0 1 9");
+  refused("index.off", index, "line 22: malformed OFF file: vertex index 9 names no vertex");
+  refused("short.off", off.substr(0, off.find("\n3 ") + 1),
+          "malformed OFF file: the file ends after 0 of the 12 faces");
+  std::string vertex = off;
+  vertex.replace(vertex.find('\n', 6) + 1, 1, "x");
+  refused("vertex.off", vertex, "line 3: malformed OFF file: a vertex line needs 3 numbers");
+  std::string face = off;
+  face.replace(face.rfind("\n3 ") + 1, 1, "5");
+  refused("face.off", face, "line 22: malformed OFF file: a face announces 5 vertices");
+  refused("4d.off", "4OFF\n1 0 0\n0 0 0 0\n", "line 1: malformed OFF file: '4OFF'");
+  refused("bin.off", "OFF BINARY\n", "binary OFF is not supported");
+  refused("counts.off", "OFF\n8 twelve 0\n", "line 2: malformed OFF file: expected the counts");
+  refused("magic.off", "PLY\n", "line 1: malformed OFF file: no OFF header");
+}
+
+TEST_F(MeshFiles, UnknownExtensionsAreRefusedNamingTheFormats) {
+  try {
+    load_mesh(write("cube.mesh", cube_obj()));
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown mesh format '.mesh' (clumpkit reads .stl, .obj, "
+                                         ".ply, .off)"),
+              std::string::npos)
+        << e.what();
+  }
+  // The extension's case does not matter.
+  EXPECT_EQ(load_mesh(write("CUBE.OFF", cube_off())).triangles.size(), 12u);
+}
+
 TEST_F(MeshFiles, BinaryStlSoupIsWeldedAndScaled) {
   // Binary STL stores every triangle's vertices separately: 3 * 320 before welding.
   const TriangleMesh ico = icosphere_mesh(2.5, 2);

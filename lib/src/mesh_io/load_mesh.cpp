@@ -14,7 +14,7 @@
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
-#include "pre_import_checks.hpp"
+#include "mesh_readers.hpp"
 
 namespace clumpkit {
 
@@ -89,16 +89,17 @@ std::size_t weld_vertices(TriangleMesh& mesh, double tol, std::size_t* collapsed
   return merged;
 }
 
-TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshReport* report) {
-  const std::string where = path.string();
-  if (!(opt.scale > 0) || !std::isfinite(opt.scale))
-    throw InputError(where, "scale", "must be a positive finite factor to metres");
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw InputError(where, "", "no such mesh file");
-  if (fs::file_size(path, ec) == 0) throw InputError(where, "", "empty file (no triangles)");
+namespace {
 
-  detail::check_ply(path, where);
-  detail::check_off(path, where);
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext;
+}
+
+// STL and OBJ through assimp, unscaled; an index naming no vertex becomes -1 (validate_mesh
+// counts it).
+TriangleMesh read_with_assimp(const fs::path& path, const std::string& where) {
   Assimp::Importer importer;
   // Only triangles and points/lines are of interest; normals, UVs and materials are not read.
   // No assimp post-processing: its steps (Triangulate, PreTransformVertices, even the structure
@@ -107,25 +108,22 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   const aiScene* scene = nullptr;
   try {
     scene = importer.ReadFile(path.string(), 0);
-  } catch (const std::bad_alloc&) {  // a count the checks above cannot see (other formats)
+  } catch (const std::bad_alloc&) {  // a corrupt count in the file
     throw InputError(where, "",
                      "the mesh importer ran out of memory reading it (a count in the file is "
                      "probably corrupt)");
   }
-  if (!scene) {
-    throw InputError(
-        where, "",
-        std::string("cannot read as a mesh (STL, OBJ, PLY, OFF): ") + importer.GetErrorString());
-  }
+  if (!scene)
+    throw InputError(where, "",
+                     std::string("cannot read as a mesh (STL, OBJ): ") + importer.GetErrorString());
   TriangleMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* am = scene->mMeshes[m];
     const int base = static_cast<int>(mesh.vertices.size());
     for (unsigned i = 0; i < am->mNumVertices; ++i) {
       const aiVector3D& v = am->mVertices[i];
-      mesh.vertices.emplace_back(opt.scale * static_cast<double>(v.x),
-                                 opt.scale * static_cast<double>(v.y),
-                                 opt.scale * static_cast<double>(v.z));
+      mesh.vertices.emplace_back(static_cast<double>(v.x), static_cast<double>(v.y),
+                                 static_cast<double>(v.z));
     }
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
@@ -138,6 +136,32 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
         mesh.triangles.emplace_back(index(0), index(k), index(k + 1));
     }
   }
+  return mesh;
+}
+
+}  // namespace
+
+TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshReport* report) {
+  const std::string where = path.string();
+  if (!(opt.scale > 0) || !std::isfinite(opt.scale))
+    throw InputError(where, "scale", "must be a positive finite factor to metres");
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(where, "", "no such mesh file");
+  if (fs::file_size(path, ec) == 0) throw InputError(where, "", "empty file (no triangles)");
+
+  const std::string ext = lower_extension(path);
+  TriangleMesh mesh;
+  if (ext == ".ply")
+    mesh = detail::read_ply(path, where);
+  else if (ext == ".off")
+    mesh = detail::read_off(path, where);
+  else if (ext == ".stl" || ext == ".obj")
+    mesh = read_with_assimp(path, where);
+  else
+    throw InputError(where, "",
+                     "unknown mesh format '" + ext + "' (clumpkit reads .stl, .obj, .ply, .off)");
+  if (opt.scale != 1.0)
+    for (Eigen::Vector3d& v : mesh.vertices) v *= opt.scale;
   if (mesh.triangles.empty()) throw InputError(where, "", "empty mesh (no triangles)");
 
   Eigen::AlignedBox3d box;

@@ -1,6 +1,6 @@
 #pragma once
-/// Reading closed triangle meshes (STL ascii/binary, OBJ, PLY, OFF) through assimp, welded,
-/// validated and oriented outward.
+/// Reading closed triangle meshes (STL ascii/binary and OBJ through assimp; PLY and OFF by
+/// clumpkit's own readers), welded, validated and oriented outward.
 #include <filesystem>
 
 #include "clumpkit/geometry/shape_spec.hpp"
@@ -20,7 +20,8 @@ struct MeshLoadOptions {
 
 /// Loads, welds and validates a mesh; flips it to outward orientation if its signed volume is
 /// negative. Throws InputError naming the file (and the defect counts) for a missing, empty,
-/// unreadable or, with `require_closed`, an open/non-manifold/self-intersecting mesh.
+/// unreadable (or not .stl, .obj, .ply, .off: the format is chosen by the extension, in any case)
+/// or, with `require_closed`, an open/non-manifold/self-intersecting mesh.
 /// `report`, if given, receives the validation report of the returned mesh.
 TriangleMesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options,
                        MeshReport* report = nullptr);
