@@ -3,6 +3,7 @@
 //              -o OUT.json
 #include <fmt/format.h>
 
+#include <cctype>
 #include <iostream>
 
 #include "cli_util.hpp"
@@ -37,9 +38,10 @@ struct FillArgs {
 // of the library (`clumpkit mesh --list`). Sets `source` provenance and the density.
 FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& density) {
   namespace fs = std::filesystem;
-  const std::string ext = fs::path(a.shape).extension().string();
-  const bool mesh_ext = ext == ".stl" || ext == ".STL" || ext == ".obj" || ext == ".OBJ" ||
-                        ext == ".ply" || ext == ".PLY" || ext == ".off" || ext == ".OFF";
+  std::string ext = fs::path(a.shape).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  // The extensions load_mesh reads, in any case (as load_mesh picks its reader).
+  const bool mesh_ext = ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off";
   auto from_surface = [](auto solid, const std::string& where) {
     return fill_shape_with_surface_distance(
         solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); }, where);
