@@ -1,11 +1,10 @@
 // OFF (Geomview's Object File Format; CGAL's and Princeton's shape benchmarks use it), read
 // completely here: see mesh_readers.hpp for why not by assimp.
-#include <charconv>
 #include <climits>
-#include <cmath>
-#include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "clumpkit/core/error.hpp"
@@ -15,50 +14,20 @@ namespace clumpkit::detail {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-// Splits a line into its space-separated words, dropping a '#' comment.
-std::vector<std::string> off_words(const std::string& line) {
-  std::vector<std::string> w;
-  std::size_t i = 0;
-  const auto space = [](char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-  };
-  while (i < line.size()) {
-    while (i < line.size() && space(line[i])) ++i;
-    if (i >= line.size() || line[i] == '#') break;
-    const std::size_t b = i;
-    while (i < line.size() && !space(line[i]) && line[i] != '#') ++i;
-    w.push_back(line.substr(b, i - b));
-  }
-  return w;
-}
-
-bool off_number(const std::string& s, double& v) {
-  char* end = nullptr;
-  v = std::strtod(s.c_str(), &end);
-  return end != s.c_str() && *end == '\0';
-}
-
-bool off_count(const std::string& s, long long& v) {
-  const char* first = s.data();
-  const char* last = first + s.size();
-  const auto [end, ec] = std::from_chars(first, last, v);
-  return ec == std::errc() && end == last;
-}
-
-}  // namespace
-
 TriangleMesh read_off(const fs::path& path, const std::string& where) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(where, "", "cannot open the file");
-  std::string line;
-  std::vector<std::string> w;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::size_t at = 0;
+  std::vector<std::string_view> w;
   int n = 0;
   const auto next = [&]() {  // the words of the next line that has any
-    while (std::getline(in, line)) {
+    while (at < text.size()) {
+      const std::size_t nl = text.find('\n', at);
+      const std::size_t stop = nl == std::string::npos ? text.size() : nl;
+      split_words(std::string_view(text).substr(at, stop - at), w, true);
+      at = nl == std::string::npos ? text.size() : nl + 1;
       ++n;
-      w = off_words(line);
       if (!w.empty()) return true;
     }
     return false;
@@ -67,7 +36,7 @@ TriangleMesh read_off(const fs::path& path, const std::string& where) {
     throw InputError(where, "line " + std::to_string(n), "malformed OFF file: " + what);
   };
   if (!next()) bad("empty (no OFF header)");
-  const std::string magic = w[0];
+  const std::string magic(w[0]);
   // [ST][C][N][4][n]OFF: texture coordinates, colours and normals only add values after x y z.
   const std::size_t off_at = magic.rfind("OFF");
   if (off_at == std::string::npos || off_at + 3 != magic.size())
@@ -87,11 +56,11 @@ TriangleMesh read_off(const fs::path& path, const std::string& where) {
   if (!counts.empty() && counts[0] == "BINARY") bad("binary OFF is not supported: only text OFF");
   if (counts.empty()) {  // counts on their own line
     if (!next()) bad("missing vertex and face counts");
-    counts = w;
+    counts.assign(w.begin(), w.end());
   }
   long long nv = -1, nf = -1;
-  if (counts.size() < 2 || counts.size() > 3 || !off_count(counts[0], nv) ||
-      !off_count(counts[1], nf) || nv < 0 || nf < 0)
+  if (counts.size() < 2 || counts.size() > 3 || !whole_integer(counts[0], nv) ||
+      !whole_integer(counts[1], nf) || nv < 0 || nf < 0)
     bad("expected the counts 'vertices faces [edges]'");
   if (nv > INT_MAX) bad("more vertices than clumpkit can index");
   TriangleMesh mesh;
@@ -100,7 +69,7 @@ TriangleMesh read_off(const fs::path& path, const std::string& where) {
       bad("the file ends after " + std::to_string(v) + " of the " + std::to_string(nv) +
           " vertices the header announces");
     double x, y, z;
-    if (w.size() < 3 || !off_number(w[0], x) || !off_number(w[1], y) || !off_number(w[2], z))
+    if (w.size() < 3 || !whole_number(w[0], x) || !whole_number(w[1], y) || !whole_number(w[2], z))
       bad("a vertex line needs 3 numbers (x y z)");
     mesh.vertices.emplace_back(x, y, z);
   }
@@ -110,14 +79,15 @@ TriangleMesh read_off(const fs::path& path, const std::string& where) {
       bad("the file ends after " + std::to_string(f) + " of the " + std::to_string(nf) +
           " faces the header announces");
     long long k = -1;
-    if (!off_count(w[0], k) || k < 1)
+    if (!whole_integer(w[0], k) || k < 1)
       bad("a face line starts with its vertex count (" + shown(w[0]) + ")");
     if (k > static_cast<long long>(w.size()) - 1)
-      bad("a face announces " + w[0] + " vertices, the line has " + std::to_string(w.size() - 1));
+      bad("a face announces " + std::string(w[0]) + " vertices, the line has " +
+          std::to_string(w.size() - 1));
     ix.clear();
     for (long long j = 1; j <= k; ++j) {
       long long i = -1;
-      if (!off_count(w[static_cast<std::size_t>(j)], i))
+      if (!whole_integer(w[static_cast<std::size_t>(j)], i))
         bad("face index " + shown(w[static_cast<std::size_t>(j)]) + " is not a whole number");
       if (i < 0 || i >= nv)
         bad("vertex index " + std::to_string(i) + " names no vertex (the file has " +

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "clumpkit/core/error.hpp"
@@ -258,35 +259,31 @@ void read_ascii_body(const std::string& text, const Header& h, Builder& out,
                      const std::string& where) {
   std::size_t at = h.body;
   int line_no = h.lines;
-  std::string line;
-  std::vector<std::string> tokens;
+  std::vector<std::string_view> tokens;
   std::vector<long long> ix;
   for (const PlyElement& e : h.elements) {
     for (long long i = 0; i < e.count; ++i) {
-      bool got = false;
-      while (ply_line(text, at, line)) {
+      tokens.clear();
+      while (at < text.size() && tokens.empty()) {  // the next line with any words
+        const std::size_t nl = text.find('\n', at);
+        const std::size_t stop = nl == std::string::npos ? text.size() : nl;
+        split_words(std::string_view(text).substr(at, stop - at), tokens, false);
+        at = nl == std::string::npos ? text.size() : nl + 1;
         ++line_no;
-        if (line.find_first_not_of(" \t") != std::string::npos) {
-          got = true;
-          break;
-        }
       }
-      if (!got)
+      if (tokens.empty())
         throw InputError(where, "line " + std::to_string(line_no),
                          "malformed PLY body: " + std::to_string(i) + " of the " +
                              std::to_string(e.count) + " " + shown(e.name) +
                              " elements the header announces");
-      tokens = ply_words(line);
       const auto bad = [&](const std::string& what) {
         throw InputError(where, "line " + std::to_string(line_no),
                          "malformed PLY body (" + shown(e.name) + " element): " + what);
       };
       const auto number = [&](std::size_t k) {
         if (k >= tokens.size()) bad("fewer values than its properties need");
-        const char* s = tokens[k].c_str();
-        char* end = nullptr;
-        const double v = std::strtod(s, &end);
-        if (end == s || *end != '\0') bad(shown(tokens[k]) + " is not a number");
+        double v = 0.0;
+        if (!whole_number(tokens[k], v)) bad(shown(tokens[k]) + " is not a number");
         return v;
       };
       std::size_t k = 0;
@@ -297,10 +294,11 @@ void read_ascii_body(const std::string& text, const Header& h, Builder& out,
           continue;
         }
         const double c = number(k++);
+        const std::string count(tokens[k - 1]);
         if (!(c >= 0) || c != std::floor(c) || c > static_cast<double>(max_count(p.count)))
-          bad("list count " + shown(tokens[k - 1]) + " is not an integer its type can hold");
+          bad("list count " + shown(count) + " is not an integer its type can hold");
         if (c > static_cast<double>(tokens.size() - k))
-          bad("a list announces " + tokens[k - 1] + " values, the line has " +
+          bad("a list announces " + count + " values, the line has " +
               std::to_string(tokens.size() - k));
         const auto n = static_cast<std::size_t>(c);
         ix.clear();
