@@ -463,6 +463,14 @@ TEST_F(MeshFiles, UnknownExtensionsAreRefusedNamingTheFormats) {
               std::string::npos)
         << e.what();
   }
+  try {
+    load_mesh(write("cube", cube_obj()));
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no file extension to tell the mesh format"),
+              std::string::npos)
+        << e.what();
+  }
   // The extension's case does not matter.
   EXPECT_EQ(load_mesh(write("CUBE.OFF", cube_off())).triangles.size(), 12u);
 }

@@ -159,7 +159,9 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
     mesh = read_with_assimp(path, where);
   else
     throw InputError(where, "",
-                     "unknown mesh format '" + ext + "' (clumpkit reads .stl, .obj, .ply, .off)");
+                     (ext.empty() ? std::string("no file extension to tell the mesh format")
+                                  : "unknown mesh format '" + ext + "'") +
+                         " (clumpkit reads .stl, .obj, .ply, .off)");
   if (opt.scale != 1.0)
     for (Eigen::Vector3d& v : mesh.vertices) v *= opt.scale;
   if (mesh.triangles.empty()) throw InputError(where, "", "empty mesh (no triangles)");
