@@ -3,7 +3,6 @@
 //              -o OUT.json
 #include <fmt/format.h>
 
-#include <cctype>
 #include <iostream>
 
 #include "cli_util.hpp"
@@ -38,26 +37,20 @@ struct FillArgs {
 // of the library (`clumpkit mesh --list`). Sets `source` provenance and the density.
 FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& density) {
   namespace fs = std::filesystem;
-  std::string ext = fs::path(a.shape).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  // The extensions load_mesh reads, in any case (as load_mesh picks its reader).
-  const bool mesh_ext = ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off";
   auto from_surface = [](auto solid, const std::string& where) {
     return fill_shape_with_surface_distance(
         solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); }, where);
   };
   std::error_code ec;
-  if (mesh_ext) {
-#ifdef CLUMPKIT_HAVE_RAYCAST
+#ifdef CLUMPKIT_HAVE_RAYCAST  // Embree is required (lib/src/raycast): every build has it
+  if (is_mesh_file(a.shape)) {
     const double scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
     TargetShape t = target_from_mesh(a.shape, scale);
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
     return from_surface(solid, a.shape);
-#else
-    throw InputError(a.shape, "SHAPE", "this build has no mesh support (raycast module)");
-#endif
   }
+#endif
   const auto& names = test_shape_names();
   const bool is_test = std::find(names.begin(), names.end(), a.shape) != names.end();
   bool have_file = fs::exists(a.shape, ec);

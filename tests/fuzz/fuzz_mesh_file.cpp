@@ -1,9 +1,9 @@
 // Fuzz target: mesh files (STL ascii/binary and OBJ through assimp, PLY and OFF through our own
 // readers), our loader's welding and our validation (load_mesh). The first byte picks the file
 // name's extension (which selects the reader: 'o' .obj, 'p' .ply, 'f' .off, anything else .stl);
-// the rest is the file, written to a per-process file under /dev/shm (the readers take paths). Each input is loaded twice:
-// as a shape (closed solid required, self-intersections checked) and as a wall (open surfaces
-// allowed), and what an accepted mesh promises is checked.
+// the rest is the file, written to a per-process file under /dev/shm (the readers take paths). Each
+// input is loaded twice: as a shape (closed solid required, self-intersections checked) and as a
+// wall (open surfaces allowed), and what an accepted mesh promises is checked.
 #include <unistd.h>
 
 #include <cmath>

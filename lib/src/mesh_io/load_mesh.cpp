@@ -141,6 +141,11 @@ TriangleMesh read_with_assimp(const fs::path& path, const std::string& where) {
 
 }  // namespace
 
+bool is_mesh_file(const fs::path& path) {
+  const std::string ext = lower_extension(path);
+  return ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off";
+}
+
 TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshReport* report) {
   const std::string where = path.string();
   if (!(opt.scale > 0) || !std::isfinite(opt.scale))

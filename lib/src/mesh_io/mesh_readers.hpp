@@ -27,23 +27,49 @@ inline std::string shown(std::string_view word) {
   return s + (word.size() > 40 ? "...'" : "'");
 }
 
-/// The words of a line as views into it, split on blanks (space, tab, CR, VT, FF); with
-/// `hash_comments` a '#' ends the line's words (OFF).
-inline void split_words(std::string_view line, std::vector<std::string_view>& words,
-                        bool hash_comments) {
-  words.clear();
-  const auto blank = [](char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-  };
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && blank(line[i])) ++i;
-    if (hash_comments && i < line.size() && line[i] == '#') return;
-    const std::size_t b = i;
-    while (i < line.size() && !blank(line[i]) && !(hash_comments && line[i] == '#')) ++i;
-    if (i > b) words.push_back(line.substr(b, i - b));
+/// Walks a file's text line by line ('\n'-terminated), handing out each line's words as views
+/// into the text, split on blanks (space, tab, CR, VT, FF); with `hash_comments` a '#' ends a
+/// line's words (OFF). Counts lines, blank ones included, for error messages; starts at byte
+/// `offset`, which follows line `line`.
+class TextLines {
+ public:
+  TextLines(const std::string& text, bool hash_comments, std::size_t offset = 0, int line = 0)
+      : text_(text), hash_comments_(hash_comments), at_(offset), line_(line) {}
+
+  /// The words of the next line that has any (blank lines skipped); false at the end.
+  bool next(std::vector<std::string_view>& words) {
+    words.clear();
+    while (at_ < text_.size() && words.empty()) {
+      const std::size_t nl = text_.find('\n', at_);
+      const std::size_t stop = nl == std::string::npos ? text_.size() : nl;
+      split(std::string_view(text_).substr(at_, stop - at_), words);
+      at_ = nl == std::string::npos ? text_.size() : nl + 1;
+      ++line_;
+    }
+    return !words.empty();
   }
-}
+  int line() const { return line_; }          ///< of the last line read, from 1
+  std::size_t offset() const { return at_; }  ///< of the first byte after it
+
+ private:
+  void split(std::string_view line, std::vector<std::string_view>& words) const {
+    const auto blank = [](char c) {
+      return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+    };
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && blank(line[i])) ++i;
+      if (hash_comments_ && i < line.size() && line[i] == '#') return;
+      const std::size_t b = i;
+      while (i < line.size() && !blank(line[i]) && !(hash_comments_ && line[i] == '#')) ++i;
+      if (i > b) words.push_back(line.substr(b, i - b));
+    }
+  }
+  const std::string& text_;
+  bool hash_comments_;
+  std::size_t at_;
+  int line_;
+};
 
 /// A whole word as a number, as strtod reads it (from_chars first: the same value where both
 /// read it, and ~10x faster on a scan's millions of values); false if any of it is left over.

@@ -1,12 +1,11 @@
 // OFF (Geomview's Object File Format; CGAL's and Princeton's shape benchmarks use it), read
 // completely here: see mesh_readers.hpp for why not by assimp.
 #include <climits>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "mesh_readers.hpp"
 
@@ -15,25 +14,12 @@ namespace clumpkit::detail {
 namespace fs = std::filesystem;
 
 TriangleMesh read_off(const fs::path& path, const std::string& where) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(where, "", "cannot open the file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::size_t at = 0;
+  const std::string text = read_file(path);
+  TextLines lines(text, true);
   std::vector<std::string_view> w;
-  int n = 0;
-  const auto next = [&]() {  // the words of the next line that has any
-    while (at < text.size()) {
-      const std::size_t nl = text.find('\n', at);
-      const std::size_t stop = nl == std::string::npos ? text.size() : nl;
-      split_words(std::string_view(text).substr(at, stop - at), w, true);
-      at = nl == std::string::npos ? text.size() : nl + 1;
-      ++n;
-      if (!w.empty()) return true;
-    }
-    return false;
-  };
+  const auto next = [&] { return lines.next(w); };
   const auto bad = [&](const std::string& what) {
-    throw InputError(where, "line " + std::to_string(n), "malformed OFF file: " + what);
+    throw InputError(where, "line " + std::to_string(lines.line()), "malformed OFF file: " + what);
   };
   if (!next()) bad("empty (no OFF header)");
   const std::string magic(w[0]);

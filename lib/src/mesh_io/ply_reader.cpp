@@ -1,18 +1,14 @@
 // PLY (Turk 1994; the format of Stanford's scans and of most scanners' exports), read completely
 // here: see mesh_readers.hpp for why not by assimp.
-#include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <map>
-#include <sstream>
 #include <string_view>
 #include <vector>
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "mesh_readers.hpp"
 
@@ -29,8 +25,8 @@ struct PlyType {
 };
 
 // PLY's scalar types with their sizes; nullptr for an unknown name.
-const PlyType* ply_type(const std::string& name) {
-  static const std::map<std::string, PlyType> types = {
+const PlyType* ply_type(std::string_view name) {
+  static const std::map<std::string, PlyType, std::less<>> types = {
       {"char", {1, true, true}},    {"uchar", {1, true, false}},   {"int8", {1, true, true}},
       {"uint8", {1, true, false}},  {"short", {2, true, true}},    {"ushort", {2, true, false}},
       {"int16", {2, true, true}},   {"uint16", {2, true, false}},  {"int", {4, true, true}},
@@ -74,39 +70,19 @@ struct Header {
   int lines = 0;         // header lines, "ply" and "end_header" included
 };
 
-// The next '\n'-terminated line of `text` from `at` (a trailing '\r' dropped); false at the end.
-bool ply_line(const std::string& text, std::size_t& at, std::string& line) {
-  if (at >= text.size()) return false;
-  const std::size_t end = text.find('\n', at);
-  const std::size_t stop = end == std::string::npos ? text.size() : end;
-  line.assign(text, at, stop - at);
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  at = end == std::string::npos ? text.size() : end + 1;
-  return true;
-}
-
-std::vector<std::string> ply_words(const std::string& line) {
-  std::istringstream in(line);
-  return {std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
-}
-
 Header read_header(const std::string& text, const std::string& where) {
   Header h;
-  std::size_t at = 0;
-  std::string line;
-  int n = 0;
+  TextLines lines(text, false);
+  std::vector<std::string_view> w;
   const auto bad = [&](const std::string& what) {
-    throw InputError(where, "line " + std::to_string(n), "malformed PLY header (" + what + ")");
+    throw InputError(where, "line " + std::to_string(lines.line()),
+                     "malformed PLY header (" + what + ")");
   };
-  if (!ply_line(text, at, line) || ply_words(line) != std::vector<std::string>{"ply"})
+  if (!lines.next(w) || lines.line() != 1 || w.size() != 1 || w[0] != "ply")
     throw InputError(where, "line 1", "not a PLY file (the first line must be 'ply')");
-  n = 1;
   bool have_format = false;
   for (;;) {
-    if (!ply_line(text, at, line)) throw InputError(where, "", "PLY header without end_header");
-    ++n;
-    const std::vector<std::string> w = ply_words(line);
-    if (w.empty()) continue;
+    if (!lines.next(w)) throw InputError(where, "", "PLY header without end_header");
     if (w[0] == "end_header") {
       if (w.size() != 1) bad("text after end_header");
       break;
@@ -128,14 +104,11 @@ Header read_header(const std::string& text, const std::string& where) {
     } else if (w[0] == "element") {
       if (w.size() != 3) bad("expected 'element NAME COUNT'");
       PlyElement e;
-      e.name = w[1];
-      e.line = n;
-      const char* first = w[2].data();
-      const char* last = first + w[2].size();
-      const auto [end, ec] = std::from_chars(first, last, e.count);
+      e.name = std::string(w[1]);
+      e.line = lines.line();
       // Every instance takes at least one byte of the file: a bound on the loops below (binary
       // elements without properties take none, but then count no more than the file's bytes).
-      if (ec != std::errc() || end != last || e.count < 0 ||
+      if (!whole_integer(w[2], e.count) || e.count < 0 ||
           static_cast<unsigned long long>(e.count) > text.size())
         bad("element count " + shown(w[2]) + " is not a whole number the file can hold");
       for (const PlyElement& o : h.elements)
@@ -153,13 +126,13 @@ Header read_header(const std::string& text, const std::string& where) {
         p.list = true;
         p.count = *count;
         p.value = *value;
-        p.name = w[4];
+        p.name = std::string(w[4]);
       } else {
         if (w.size() != 3) bad("expected 'property TYPE NAME'");
         const PlyType* value = ply_type(w[1]);
         if (!value) bad("unknown property type " + shown(w[1]));
         p.value = *value;
-        p.name = w[2];
+        p.name = std::string(w[2]);
       }
       for (const PlyProperty& o : h.elements.back().properties)
         if (o.name == p.name) bad("a second property " + shown(p.name));
@@ -169,8 +142,8 @@ Header read_header(const std::string& text, const std::string& where) {
     }
   }
   if (!have_format) throw InputError(where, "", "malformed PLY header (no format line)");
-  h.body = at;
-  h.lines = n;
+  h.body = lines.offset();
+  h.lines = lines.line();
   return h;
 }
 
@@ -257,27 +230,20 @@ class Builder {
 // count an integer within its type's range followed by at least that many numbers.
 void read_ascii_body(const std::string& text, const Header& h, Builder& out,
                      const std::string& where) {
-  std::size_t at = h.body;
-  int line_no = h.lines;
+  TextLines lines(text, false, h.body, h.lines);  // numbered on from the header's
   std::vector<std::string_view> tokens;
   std::vector<long long> ix;
   for (const PlyElement& e : h.elements) {
+    const bool vertex = e.name == "vertex";
     for (long long i = 0; i < e.count; ++i) {
-      tokens.clear();
-      while (at < text.size() && tokens.empty()) {  // the next line with any words
-        const std::size_t nl = text.find('\n', at);
-        const std::size_t stop = nl == std::string::npos ? text.size() : nl;
-        split_words(std::string_view(text).substr(at, stop - at), tokens, false);
-        at = nl == std::string::npos ? text.size() : nl + 1;
-        ++line_no;
-      }
+      lines.next(tokens);
       if (tokens.empty())
-        throw InputError(where, "line " + std::to_string(line_no),
+        throw InputError(where, "line " + std::to_string(lines.line()),
                          "malformed PLY body: " + std::to_string(i) + " of the " +
                              std::to_string(e.count) + " " + shown(e.name) +
                              " elements the header announces");
       const auto bad = [&](const std::string& what) {
-        throw InputError(where, "line " + std::to_string(line_no),
+        throw InputError(where, "line " + std::to_string(lines.line()),
                          "malformed PLY body (" + shown(e.name) + " element): " + what);
       };
       const auto number = [&](std::size_t k) {
@@ -312,7 +278,7 @@ void read_ascii_body(const std::string& text, const Header& h, Builder& out,
         k += n;
         if (p.role != Role::Skip) out.indices(p.role, ix, bad);
       }
-      if (e.name == "vertex") out.end_vertex();
+      if (vertex) out.end_vertex();
     }
   }
 }
@@ -355,6 +321,7 @@ void read_binary_body(const std::string& text, const Header& h, Builder& out,
     return static_cast<double>(v);
   };
   for (const PlyElement& e : h.elements) {
+    const bool vertex = e.name == "vertex";
     for (long long i = 0; i < e.count; ++i) {
       const auto bad = [&](const std::string& what) {
         throw InputError(where, "byte " + std::to_string(at - h.body) + " of the body",
@@ -385,7 +352,7 @@ void read_binary_body(const std::string& text, const Header& h, Builder& out,
         for (long long j = 0; j < c; ++j) ix.push_back(static_cast<long long>(value(p.value)));
         out.indices(p.role, ix, bad);
       }
-      if (e.name == "vertex") out.end_vertex();
+      if (vertex) out.end_vertex();
     }
   }
 }
@@ -393,9 +360,7 @@ void read_binary_body(const std::string& text, const Header& h, Builder& out,
 }  // namespace
 
 TriangleMesh read_ply(const fs::path& path, const std::string& where) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(where, "", "cannot open the file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = read_file(path);
   Header h = read_header(text, where);
   const long long vertices = assign_roles(h, where);
   TriangleMesh mesh;

@@ -2,9 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
-
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/core/units.hpp"
@@ -15,13 +12,6 @@
 namespace clumpkit {
 
 namespace fs = std::filesystem;
-
-bool is_mesh_file(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off";
-}
 
 TargetShape target_from_shape(const ShapeSpec& shape) {
   TargetShape t;

@@ -18,6 +18,9 @@ struct MeshLoadOptions {
   bool check_self_intersections = true;
 };
 
+/// True for the file names load_mesh reads: .stl .obj .ply .off, in any case.
+bool is_mesh_file(const std::filesystem::path& path);
+
 /// Loads, welds and validates a mesh; flips it to outward orientation if its signed volume is
 /// negative. Throws InputError naming the file (and the defect counts) for a missing, empty,
 /// unreadable (or not .stl, .obj, .ply, .off: the format is chosen by the extension, in any case)

@@ -7,6 +7,7 @@
 
 #include "clumpkit/geometry/clump_template.hpp"
 #include "clumpkit/geometry/shape_spec.hpp"
+#include "clumpkit/mesh_io/load_mesh.hpp"  // is_mesh_file: which paths are meshes
 #include "clumpkit/raycast/surface_solid.hpp"
 
 namespace clumpkit {
@@ -16,9 +17,6 @@ struct TargetShape {
   std::string description;              ///< e.g. "cylinder D 6 mm H 5.4 mm" or the mesh path
   double density = 0.0;                 ///< kg/m^3 if the source says, else 0
 };
-
-/// True for file names that assimp reads as meshes here (.stl .obj .ply .off, any case).
-bool is_mesh_file(const std::filesystem::path& path);
 
 /// A ShapeSpec as a solid: a cylinder exactly, a mesh through load_shape_mesh.
 TargetShape target_from_shape(const ShapeSpec& shape);
