@@ -149,20 +149,22 @@ def write_template(path, name, centres, radii, est, density):
     r = pts - com
     m = density * vol
     inertia = m * (np.eye(3) * (r ** 2).sum(1).mean() - (r.T @ r) / len(r))
-    moments = np.linalg.eigvalsh(inertia)
+    moments, axes = np.linalg.eigh(inertia)  # the template is written in the principal frame
+    if np.linalg.det(axes) < 0:
+        axes[:, 2] *= -1
     tpl = {
         "format": "clumpkit-clump/1",
         "name": name,
         "units": "SI: m, kg, kg m^2",
-        "spheres": [list(map(float, c - com)) + [float(ri)] for c, ri in zip(centres, radii)],
+        "spheres": [list(map(float, axes.T @ (c - com))) + [float(ri)] for c, ri in zip(centres, radii)],
         "mass_properties": {
             "basis": "sphere_union", "density": density, "volume": vol, "mass": m,
-            "center_of_mass": [0.0, 0.0, 0.0], "inertia_tensor": inertia.tolist(),
+            "center_of_mass": [0.0, 0.0, 0.0], "inertia_tensor": np.diag(moments).tolist(),
             "principal_moments": moments.tolist(),
             "method": {"integration": "monte_carlo points of bench/ring_families.py", "points": len(est.p)},
         },
         "frame": {"convention": "p_source = rotation * p_template + translation",
-                  "rotation": np.eye(3).tolist(), "translation": com.tolist()},
+                  "rotation": axes.tolist(), "translation": com.tolist()},
         "source": {"kind": "test_shape", "shape": "pill_C_chamfered",
                    "description": "axisymmetric design searched by bench/ring_families.py"},
         "method": {"name": "ring_families (bench)"},
