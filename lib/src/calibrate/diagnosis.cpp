@@ -586,9 +586,12 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
   }
   // The other side of the baseline. A probe on one side says little about the other (a heap
   // barely feels pill-pill friction above Table 1's 0.47 and a lot below it), so where the data
-  // are inconsistent with the baseline and a candidate's fit lies on the side it was not probed
-  // on, its surrogate there is a guess: one screening run at the mirrored probe gives it a point
-  // before the candidates are ranked.
+  // are inconsistent with the baseline, a candidate's surrogate on its unprobed side is a guess:
+  // one screening run at the mirrored probe gives it a point there before the candidates are
+  // ranked. It is made where the candidate's fit lies on that side, and where its line cannot
+  // explain the data without pointing past the probe (below): the slope of a one-repeat probe
+  // is seed noise where the response on the probed side is flat, and with Table 1's pills a
+  // lower pill-pill friction went unseen because a noisy probe pulled its fit up.
   const double p_screened = chi2_survival(compare(ms, pool.pooled(s0), 0).chi2, n);
   const bool inconsistent = p_screened < o.p_inconsistent;
   // A baseline the screen leaves consistent with the data (p >= p_screen_only) gets no verdict
@@ -624,33 +627,41 @@ Diagnosis diagnose(const ParticleModel& base, const std::vector<Measurement>& ms
     if (w.c.discrete || w.s.points.size() != 2) return std::numeric_limits<double>::quiet_NaN();
     return w.s.points[0].first == w.c.baseline ? w.s.points[1].first : w.s.points[0].first;
   };
+  // Beyond the probe. A response can stay flat up to the probe and set in past it (the heap
+  // barely feels restitution from Table 1's 0.2 to 0.5 and a lot at 0.7): a candidate whose
+  // line through the baseline and the probe points past the probe, removes part of the misfit
+  // (chi2 down by 4 or more) but still cannot explain the data gets one screening run at twice
+  // the probe's step, before the candidates are ranked; otherwise a competitor that explains
+  // the data at once (a lower rolling friction) would take the verdict unchallenged. Returns that
+  // value, or NaN where no such run is due.
+  const auto further_on = [&](const Work& w) {
+    constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+    const double probe = probe_of(w);
+    const double step = probe - w.c.baseline;
+    if (std::isnan(probe) || (w.fit.theta - probe) * step <= 0.0) return kNone;  // not past it
+    const std::vector<double> var = fit_variances(ms, pool.pooled(s0), w.s);
+    if (chi2_of(ms, var, w.s, w.c.baseline) - w.fit.chi2 < 4.0) return kNone;
+    if (chi2_survival(w.fit.chi2, n) >= o.p_inconsistent) return kNone;  // explains the data
+    const double f = std::clamp(w.c.baseline + 2.0 * step, w.lo_ok, w.hi_ok);
+    return f != probe ? f : kNone;
+  };
   if (inconsistent) {
     std::vector<std::pair<Work*, double>> mirrors;
     for (Work& w : work) {
       const double probe = probe_of(w);
-      if (std::isnan(probe) || (probe - w.c.baseline) * (w.fit.theta - w.c.baseline) >= 0.0)
-        continue;
+      if (std::isnan(probe)) continue;
+      const bool other_side = (probe - w.c.baseline) * (w.fit.theta - w.c.baseline) < 0.0;
+      const bool unexplained =
+          chi2_survival(w.fit.chi2, n) < o.p_inconsistent && std::isnan(further_on(w));
+      if (!other_side && !unexplained) continue;
       const double m = std::clamp(2.0 * w.c.baseline - probe, w.lo_ok, w.hi_ok);
       if (m != w.c.baseline) mirrors.emplace_back(&w, m);
     }
     screen_more(mirrors, "on the other side");
-    // Beyond the probe. A response can stay flat up to the probe and set in past it (the heap
-    // barely feels restitution from Table 1's 0.2 to 0.5 and a lot at 0.7): a candidate whose
-    // line through the baseline and the probe points past the probe, removes part of the misfit
-    // (chi2 down by 4 or more) but still cannot explain the data gets one screening run at twice
-    // the probe's step, before the candidates are ranked; otherwise a competitor that explains
-    // the data at once (a lower rolling friction) would take the verdict unchallenged.
     std::vector<std::pair<Work*, double>> further;
-    const Values pooled = pool.pooled(s0);
     for (Work& w : work) {
-      const double probe = probe_of(w);
-      const double step = probe - w.c.baseline;
-      if (std::isnan(probe) || (w.fit.theta - probe) * step <= 0.0) continue;  // not past it
-      const std::vector<double> var = fit_variances(ms, pooled, w.s);
-      if (chi2_of(ms, var, w.s, w.c.baseline) - w.fit.chi2 < 4.0) continue;
-      if (chi2_survival(w.fit.chi2, n) >= o.p_inconsistent) continue;  // explains the data
-      const double f = std::clamp(w.c.baseline + 2.0 * step, w.lo_ok, w.hi_ok);
-      if (f != probe) further.emplace_back(&w, f);
+      const double f = further_on(w);
+      if (!std::isnan(f)) further.emplace_back(&w, f);
     }
     screen_more(further, "further on");
   }
