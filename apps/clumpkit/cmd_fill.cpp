@@ -63,6 +63,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     source = {{"shape", a.shape},
               {"kind", "test_shape"},
               {"description", test_shape_description(a.shape)},
+              {"seed", a.seed},  // the rock's shape depends on it
               {"volume", solid->volume()}};
     return s;
   }
