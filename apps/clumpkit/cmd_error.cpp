@@ -62,9 +62,15 @@ Row analyse(const std::string& path, const ErrorArgs& a) {
   const ClumpTemplate clump = load_clump(path);
   TargetShape target;
   const nlohmann::json& src = clump.source;
-  if (a.shape.empty() && src.is_object() && src.value("kind", "") == "test_shape" &&
-      is_test_shape(src.value("shape", ""))) {
-    target = target_from_test_shape(src.value("shape", ""), src.value("seed", std::uint64_t{1}));
+  auto text = [&](const char* key) {
+    const auto it = src.is_object() ? src.find(key) : src.end();
+    return it != src.end() && it->is_string() ? it->get<std::string>() : std::string();
+  };
+  if (a.shape.empty() && text("kind") == "test_shape" && is_test_shape(text("shape"))) {
+    const auto seed = src.find("seed");  // older templates have none: the default, 1
+    target = target_from_test_shape(text("shape"), seed != src.end() && seed->is_number_unsigned()
+                                                       ? seed->get<std::uint64_t>()
+                                                       : std::uint64_t{1});
   } else if (a.shape.empty()) {
     target = target_from_source(clump, path);
   } else if (!is_mesh_file(a.shape) && is_test_shape(a.shape) &&
