@@ -129,20 +129,19 @@ TEST_F(ErrorCli, TemplatesOfTheBundledTestShapesAreMeasuredAgainstTheirSource) {
   const nlohmann::json t = nlohmann::json::parse(in);
   EXPECT_NEAR(t["error"]["symmetric_difference"]["value"].get<double>(),
               j["symmetric_difference"]["rel"].get<double>(), 3e-3);
-  const CliRun named = run("error " + path("torus8.json") +
-                           " --shape torus --rays 200000 --samples 2000 --json -");
+  const CliRun named =
+      run("error " + path("torus8.json") + " --shape torus --rays 200000 --samples 2000 --json -");
   ASSERT_EQ(named.status, 0) << named.out;
-  EXPECT_EQ(nlohmann::json::parse(named.out)["symmetric_difference"],
-            j["symmetric_difference"]);
+  EXPECT_EQ(nlohmann::json::parse(named.out)["symmetric_difference"], j["symmetric_difference"]);
   // The rock is rebuilt with the seed its fill recorded.
   const CliRun rock = run("error " + path("rock8.json") + " --rays 200000 --samples 2000 --json -");
   ASSERT_EQ(rock.status, 0) << rock.out;
   std::ifstream rin(path("rock8.json"));
   EXPECT_NEAR(nlohmann::json::parse(rin)["error"]["symmetric_difference"]["value"].get<double>(),
               nlohmann::json::parse(rock.out)["symmetric_difference"]["rel"].get<double>(), 3e-3);
-  const CliRun table = run("error --table " + path("torus8.json") + " " + path("rock8.json") +
-                           " " + path("A4.json") + " --rays 100000 --samples 1000 --plot " +
-                           path("set.svg"));
+  const CliRun table =
+      run("error --table " + path("torus8.json") + " " + path("rock8.json") + " " +
+          path("A4.json") + " --rays 100000 --samples 1000 --plot " + path("set.svg"));
   ASSERT_EQ(table.status, 0) << table.out;
   for (const char* s : {"torus", "rock", "pill_A"})
     EXPECT_NE(table.out.find(s), std::string::npos) << table.out;
