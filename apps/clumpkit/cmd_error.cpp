@@ -41,11 +41,6 @@ struct Row {
 // exact). The rock's shape depends on its seed.
 constexpr int kTestShapeTriangles = 100000;
 
-bool is_test_shape(const std::string& name) {
-  const auto& names = test_shape_names();
-  return std::find(names.begin(), names.end(), name) != names.end();
-}
-
 TargetShape target_from_test_shape(const std::string& name, std::uint64_t seed) {
   const TessellatedMesh t = make_test_shape(name, seed)->tessellate(kTestShapeTriangles);
   TriangleMesh mesh;

@@ -51,8 +51,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     return from_surface(solid, a.shape);
   }
 #endif
-  const auto& names = test_shape_names();
-  const bool is_test = std::find(names.begin(), names.end(), a.shape) != names.end();
+  const bool is_test = is_test_shape(a.shape);
   bool have_file = fs::exists(a.shape, ec);
   if (!have_file && !is_test) have_file = true;  // let resolve_shape report the missing file
   if (!have_file || (is_test && !fs::exists(data_dir() / "shapes" / (a.shape + ".toml"), ec))) {

@@ -690,6 +690,11 @@ const std::vector<std::string>& test_shape_names() {
   return names;
 }
 
+bool is_test_shape(const std::string& name) {
+  const auto& names = test_shape_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
 std::string test_shape_description(const std::string& name) {
   for (const Entry& e : kShapes)
     if (name == e.name) return e.description;

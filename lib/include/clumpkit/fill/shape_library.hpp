@@ -164,6 +164,8 @@ class ExtrudedPolygon final : public AnalyticSolid {
 
 /// Names of the bundled test shapes, in table order.
 const std::vector<std::string>& test_shape_names();
+/// Whether `name` is one of test_shape_names().
+bool is_test_shape(const std::string& name);
 /// One-line description (dimensions) of a test shape.
 std::string test_shape_description(const std::string& name);
 /// Builds a test shape; `seed` only matters for "rock". Throws InputError (field "SHAPE") listing
