@@ -347,14 +347,6 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
   }
 }
 
-// A hidden effect on the side of the baseline the candidate was not probed on, where the
-// response differs: pill-pill friction probed upward from Table 1's 0.466 (to 0.716) where the
-// heap has stopped feeling it, hidden at 0.2 where it feels it strongly (the mini heaps: 27-31
-// deg at 0.466 and 0.8, 21-25 deg at 0.2). Extrapolated from the flat side the surrogate saw
-// nothing: in the mini case of session 14 particle friction was not even refined (surrogate chi2
-// 49 at mu_s 0.013, the baseline's 46) and the verdict went to another effect. A screening run at
-// the mirrored probe gives the unprobed side a point. Without it this stand-in's verdict is
-// restitution pinned at its bound (particle friction 0.36, chi2 54 from its surrogate).
 namespace {
 
 // Pill-pill friction that saturates (the stand-in sees 1.5 (1 - exp(-mu / 0.15))): flat above
@@ -400,6 +392,14 @@ Diagnosis diagnose_lower_friction(SaturatingFriction& sim, std::uint64_t seed, s
 
 }  // namespace
 
+// A hidden effect on the side of the baseline the candidate was not probed on, where the
+// response differs: pill-pill friction probed upward from Table 1's 0.466 (to 0.716) where the
+// heap has stopped feeling it, hidden at 0.2 where it feels it strongly (the mini heaps: 27-31
+// deg at 0.466 and 0.8, 21-25 deg at 0.2). Extrapolated from the flat side the surrogate saw
+// nothing: in the mini case of session 14 particle friction was not even refined (surrogate chi2
+// 49 at mu_s 0.013, the baseline's 46) and the verdict went to another effect. A screening run at
+// the mirrored probe gives the unprobed side a point. Without it this stand-in's verdict is
+// restitution pinned at its bound (particle friction 0.36, chi2 54 from its surrogate).
 TEST(Diagnosis, AnEffectOnTheUnprobedSideOfTheBaselineIsFound) {
   for (std::uint64_t seed : {31u, 32u, 33u}) {
     SaturatingFriction sim;
