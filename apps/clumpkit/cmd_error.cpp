@@ -28,6 +28,7 @@ struct ErrorArgs {
   std::size_t samples = ShapeErrorOptions{}.surface_samples;
   int replicates = RaySamplingOptions{}.replicates;
   bool table = false;
+  bool repair_orientation = false;
 };
 
 struct Row {
@@ -73,9 +74,12 @@ Row analyse(const std::string& path, const ErrorArgs& a) {
     target = target_from_test_shape(a.shape, 1);
   } else if (is_mesh_file(a.shape)) {
     target =
-        target_from_mesh(a.shape, unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units"));
+        target_from_mesh(a.shape, unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units"),
+                         a.repair_orientation);
   } else {
-    target = target_from_shape(load_shape(resolve_shape(a.shape)));
+    ShapeSpec spec = load_shape(resolve_shape(a.shape));
+    spec.repair_orientation = spec.repair_orientation || a.repair_orientation;
+    target = target_from_shape(spec);
   }
   ShapeErrorOptions opt;
   opt.sampling.rays = a.rays;
@@ -255,6 +259,9 @@ Command setup_error(CLI::App& parent) {
                 "test shape of `clumpkit mesh --list`: torus) or "
                 "a closed mesh (.stl .obj .ply .off); default: the template's recorded source");
   c->add_option("--mesh-units", a->mesh_units, "Length unit of a --shape mesh file (m, mm, ...)");
+  c->add_flag("--repair-orientation", a->repair_orientation,
+              "Re-orient a --shape mesh (closed, manifold) whose triangles disagree on "
+              "orientation instead of refusing it (a template's recorded mesh: as it was filled)");
   c->add_option("--rays", a->rays, "Rays in total (3 axes x replicates)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{2'000'000'000}));
   c->add_option("--seed", a->seed, "Seed of the ray jitter and surface samples");

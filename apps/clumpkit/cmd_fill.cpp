@@ -31,7 +31,14 @@ struct FillArgs {
   double max_error = 0.0;
   std::string metric = "symmetric_difference", min_radius, tolerance, mesh_units = "m", density;
   int grid = FillOptions{}.grid;
+  bool repair_orientation = false;
 };
+
+// A note on stderr when the loader re-oriented the mesh's triangles (--repair-orientation).
+void note_reoriented(const TargetShape& t) {
+  if (t.reoriented_faces > 0)
+    std::cerr << fmt::format("clumpkit: note: re-oriented the triangles of {}\n", t.description);
+}
 
 // The shape of an edt/optimal fill: a mesh file, a shape file (or bundled shape), or a test shape
 // of the library (`clumpkit mesh --list`). Sets `source` provenance and the density.
@@ -45,9 +52,11 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
 #ifdef CLUMPKIT_HAVE_RAYCAST  // Embree is required (lib/src/raycast): every build has it
   if (is_mesh_file(a.shape)) {
     const double scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
-    TargetShape t = target_from_mesh(a.shape, scale);
+    TargetShape t = target_from_mesh(a.shape, scale, a.repair_orientation);
+    note_reoriented(t);
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
+    if (a.repair_orientation) source["repair_orientation"] = true;
     return from_surface(solid, a.shape);
   }
 #endif
@@ -66,7 +75,8 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
               {"volume", solid->volume()}};
     return s;
   }
-  const ShapeSpec spec = load_shape(resolve_shape(a.shape));
+  ShapeSpec spec = load_shape(resolve_shape(a.shape));
+  spec.repair_orientation = spec.repair_orientation || a.repair_orientation;
   density = spec.density;
   source = {{"shape", spec.name},
             {"file", spec.path.string()},
@@ -84,10 +94,12 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   }
 #ifdef CLUMPKIT_HAVE_RAYCAST
   TargetShape t = target_from_shape(spec);
+  note_reoriented(t);
   std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
   source["kind"] = "mesh";
   source["mesh"] = spec.mesh.string();
   source["mesh_scale"] = spec.mesh_scale;
+  if (spec.repair_orientation) source["repair_orientation"] = true;
   return from_surface(solid, spec.path.string());
 #else
   throw InputError(spec.path.string(), "shape.kind", "this build has no mesh support (raycast)");
@@ -168,6 +180,9 @@ Command setup_fill(CLI::App& parent) {
                 "edt/optimal: how far a sphere may leave the shape (\"0.05 mm\"; default 1 % of "
                 "the volume-equivalent diameter)");
   c->add_option("--mesh-units", args->mesh_units, "Length unit of a mesh file (m, mm, ...)");
+  c->add_flag("--repair-orientation", args->repair_orientation,
+              "edt/optimal: re-orient a closed, manifold mesh whose triangles disagree on "
+              "orientation (or whose bodies face inward) instead of refusing it");
   c->add_option("--density", args->density,
                 "edt/optimal: density (\"1380 kg/m^3\"; default the shape file's, else 1380)");
   c->add_option("--grid", args->grid, "edt/optimal: distance-grid cells along the longest side")

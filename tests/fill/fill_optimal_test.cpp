@@ -291,6 +291,33 @@ TEST(FillCli, MeshRoundTripAndOpenMeshRefused) {
   EXPECT_FALSE(last_error().empty());
 }
 
+// A closed mesh whose triangles disagree on orientation (every fifth reversed, as a careless
+// exporter or a merged scan leaves them): refused with exit 2 and the remedy named, no output;
+// with --repair-orientation filled, the repair noted on stderr and recorded in the template's
+// source, so that `clumpkit error` re-reads the mesh the same way.
+TEST(FillCli, InconsistentlyOrientedMeshIsRefusedOrRepairedOnRequest) {
+  TessellatedMesh t = make_test_shape("torus")->tessellate(3000);
+  for (std::size_t f = 0; f < t.triangles.size(); f += 5)
+    std::swap(t.triangles[f][1], t.triangles[f][2]);
+  ASSERT_FALSE(t.is_closed_and_oriented());
+  const auto mesh = scratch("scrambled_torus.stl"), out = scratch("scrambled_torus.json");
+  std::ofstream(mesh) << to_ascii_stl(t, "scrambled", 1000.0);  // millimetres
+  const std::string fill =
+      "fill " + mesh.string() + " --mesh-units mm --method optimal --spheres 6 -o " + out.string();
+  EXPECT_EQ(run(fill), 2);
+  EXPECT_NE(last_error().find("edges with inconsistent orientation"), std::string::npos)
+      << last_error();
+  EXPECT_NE(last_error().find("--repair-orientation"), std::string::npos) << last_error();
+  EXPECT_FALSE(std::filesystem::exists(out));
+  ASSERT_EQ(run(fill + " --repair-orientation"), 0) << last_error();
+  EXPECT_NE(last_error().find("re-oriented"), std::string::npos) << last_error();
+  std::ifstream in(out);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("source").at("repair_orientation"), true);
+  EXPECT_LT(j.at("error").at("symmetric_difference").at("value").get<double>(), 0.5);
+  EXPECT_EQ(run("error " + out.string() + " --rays 20000"), 0) << last_error();
+}
+
 // Real-world meshes from a Debian package (libcgal-demo: CGAL's data archive), read at test time:
 // a scanned elephant and cow and a CAD anchor fill through the mesh path, and the optimiser beats
 // the EDT baseline on each at 12 spheres; a scan with self-intersecting triangles (the bull) is
@@ -304,7 +331,9 @@ TEST(FillCli, RealMeshesFromDebiansCgalData) {
   const std::vector<std::string> fill = {"elephant", "cow", "anchor"};
   std::string members;
   for (const auto& m : fill) members += " data/meshes/" + m + ".off";
-  members += " data/meshes/bull.off";
+  members +=
+      " data/meshes/bull.off data/meshes/blobby-shuffled.off data/meshes/oblong-shuffled.off"
+      " data/meshes/boeing.off";
   const std::string tar = "tar xzf " + archive.string() + " -C " + dir.string() + members;
   ASSERT_EQ(std::system(tar.c_str()), 0) << tar;
   auto error_of = [](const std::filesystem::path& f) {
@@ -331,5 +360,16 @@ TEST(FillCli, RealMeshesFromDebiansCgalData) {
             2);
   EXPECT_NE(last_error().find("self-intersecting"), std::string::npos) << last_error();
   EXPECT_FALSE(std::filesystem::exists(bull));
+  // The archive's meshes whose triangles were shuffled in orientation (and the boeing, saved
+  // that way): refused as they are, filled with --repair-orientation.
+  for (const std::string m : {"blobby-shuffled", "oblong-shuffled", "boeing"}) {
+    const auto mesh = dir / "data" / "meshes" / (m + ".off");
+    const auto out = dir / (m + ".json");
+    const std::string cmd =
+        "fill " + mesh.string() + " --method edt --spheres 4 -o " + out.string();
+    EXPECT_EQ(run(cmd), 2) << m;
+    EXPECT_NE(last_error().find("inconsistent orientation"), std::string::npos) << last_error();
+    EXPECT_EQ(run(cmd + " --repair-orientation"), 0) << m << ": " << last_error();
+  }
 }
 #endif

@@ -2,8 +2,9 @@
 // readers), our loader's welding and our validation (load_mesh). The first byte picks the file
 // name's extension (which selects the reader: 'o' .obj, 'p' .ply, 'f' .off, anything else .stl);
 // the rest is the file, written to a per-process file under /dev/shm (the readers take paths). Each
-// input is loaded twice: as a shape (closed solid required, self-intersections checked) and as a
-// wall (open surfaces allowed), and what an accepted mesh promises is checked.
+// input is loaded three times: as a shape (closed solid required, self-intersections checked), as a
+// shape whose orientation may be repaired, and as a wall (open surfaces allowed), and what an
+// accepted mesh promises is checked.
 #include <unistd.h>
 
 #include <cmath>
@@ -53,12 +54,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
   }
-  for (const bool closed : {true, false}) {
+  // As a shape, as a shape with its orientation repaired on request, and as a wall.
+  for (const int mode : {0, 1, 2}) {
+    const bool closed = mode < 2;
     fuzz::input_errors_only([&] {
       MeshLoadOptions o;
       o.scale = 0.001;
       o.require_closed = closed;
       o.check_self_intersections = closed;
+      o.repair_orientation = mode == 1;
       MeshReport r;
       const TriangleMesh m = load_mesh(path, o, &r);
       check_mesh(m, r, closed);

@@ -27,6 +27,7 @@ ShapeSpec parse_shape(const std::string& text, const std::filesystem::path& path
     s.mesh = path.parent_path() / doc.string("shape.file");
     const std::string unit = doc.string_opt("shape.units").value_or("m");
     s.mesh_scale = unit_factor(unit, Dimension::Length, path.string(), "shape.units");
+    s.repair_orientation = doc.boolean_opt("shape.repair_orientation").value_or(false);
   } else {
     doc.fail("shape.kind", "unknown kind '" + kind + "' (expected cylinder or mesh)");
   }

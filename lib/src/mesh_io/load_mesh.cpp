@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
+#include "clumpkit/mesh_io/orientation.hpp"
 #include "mesh_readers.hpp"
 
 namespace clumpkit {
@@ -184,6 +185,11 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   MeshValidateOptions vopt;
   vopt.check_self_intersections = opt.check_self_intersections;
   MeshReport r = validate_mesh(mesh, vopt);
+  if (opt.repair_orientation && r.orientation_repairable()) {
+    const std::size_t reversed = orient_outward(mesh, where);
+    r = validate_mesh(mesh, vopt);
+    r.reoriented_faces = reversed;
+  }
   r.welded_vertices = welded;
   r.collapsed_faces = collapsed;
   // Even an open surface (a wall) must index existing vertices with finite coordinates: those
@@ -211,6 +217,7 @@ TriangleMesh load_shape_mesh(const ShapeSpec& shape, MeshReport* report) {
     throw InputError(shape.path.string(), "shape.kind", "not a mesh shape");
   MeshLoadOptions opt;
   opt.scale = shape.mesh_scale;
+  opt.repair_orientation = shape.repair_orientation;
   return load_mesh(shape.mesh, opt, report);
 }
 

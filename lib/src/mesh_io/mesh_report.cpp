@@ -7,14 +7,21 @@
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
+#include "clumpkit/mesh_io/orientation.hpp"
 #include "self_intersections.hpp"
 
 namespace clumpkit {
 
 bool MeshReport::closed_solid() const {
   return triangles > 0 && nonfinite_vertices == 0 && bad_indices == 0 && boundary_edges == 0 &&
-         nonmanifold_edges == 0 && inconsistent_edges == 0 && self_intersections <= 0 &&
-         signed_volume != 0.0;
+         nonmanifold_edges == 0 && inconsistent_edges == 0 && misoriented_bodies == 0 &&
+         self_intersections <= 0 && signed_volume != 0.0;
+}
+
+bool MeshReport::orientation_repairable() const {
+  return triangles > 0 && nonfinite_vertices == 0 && bad_indices == 0 && boundary_edges == 0 &&
+         nonmanifold_edges == 0 && self_intersections <= 0 &&
+         (inconsistent_edges > 0 || misoriented_bodies > 0);
 }
 
 std::string MeshReport::defects() const {
@@ -30,6 +37,9 @@ std::string MeshReport::defects() const {
   add(boundary_edges, "boundary (open) edges");
   add(nonmanifold_edges, "non-manifold edges");
   add(inconsistent_edges, "edges with inconsistent orientation");
+  // An inverted body beside others, or a cavity's wall facing outward.
+  add(misoriented_bodies, misoriented_bodies == 1 ? "body inside out for its nesting"
+                                                  : "bodies inside out for their nesting");
   if (self_intersections > 0)
     add(static_cast<std::size_t>(self_intersections), "self-intersecting triangle pairs");
   add(degenerate_faces, "degenerate faces");
@@ -91,6 +101,11 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidateOptions& op
   const bool topology_ok = r.triangles > 0 && r.nonfinite_vertices == 0 && r.bad_indices == 0 &&
                            r.boundary_edges == 0 && r.nonmanifold_edges == 0 &&
                            r.inconsistent_edges == 0;
+  if (topology_ok) {
+    const BodyOrientation b = body_orientation(mesh);
+    r.bodies = b.bodies;
+    r.misoriented_bodies = b.misoriented;
+  }
   if (opt.check_self_intersections && topology_ok)
     r.self_intersections = detail::count_self_intersections(mesh);
   return r;
@@ -98,10 +113,15 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidateOptions& op
 
 void require_closed_solid(const MeshReport& report, const std::string& where) {
   if (report.closed_solid()) return;
+  std::string hint;
+  if (report.orientation_repairable())
+    hint =
+        "; it is closed and manifold, so its triangles can be re-oriented: give "
+        "--repair-orientation (a shape file: repair_orientation = true under [shape])";
   throw InputError(where, "",
                    fmt::format("{} ({} vertices, {} triangles): not a closed solid, its volume "
-                               "would be meaningless",
-                               report.defects(), report.vertices, report.triangles));
+                               "would be meaningless{}",
+                               report.defects(), report.vertices, report.triangles, hint));
 }
 
 }  // namespace clumpkit

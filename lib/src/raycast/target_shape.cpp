@@ -13,6 +13,16 @@ namespace clumpkit {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// ", 12 of them re-oriented" when the loader repaired the orientation.
+std::string reoriented(const MeshReport& r) {
+  return r.reoriented_faces > 0 ? fmt::format(", {} of them re-oriented", r.reoriented_faces)
+                                : std::string();
+}
+
+}  // namespace
+
 TargetShape target_from_shape(const ShapeSpec& shape) {
   TargetShape t;
   t.density = shape.density;
@@ -21,18 +31,25 @@ TargetShape target_from_shape(const ShapeSpec& shape) {
     t.description = fmt::format("{}: cylinder D {:.6g} mm H {:.6g} mm (exact)", shape.name,
                                 shape.diameter * 1e3, shape.height * 1e3);
   } else {
-    t.solid = std::make_unique<MeshSolid>(load_shape_mesh(shape));
-    t.description = fmt::format("{}: mesh {}", shape.name, shape.mesh.string());
+    MeshReport report;
+    t.solid = std::make_unique<MeshSolid>(load_shape_mesh(shape, &report));
+    t.description = fmt::format("{}: mesh {} ({} triangles{})", shape.name, shape.mesh.string(),
+                                report.triangles, reoriented(report));
+    t.reoriented_faces = report.reoriented_faces;
   }
   return t;
 }
 
-TargetShape target_from_mesh(const fs::path& path, double scale) {
+TargetShape target_from_mesh(const fs::path& path, double scale, bool repair_orientation) {
   TargetShape t;
   MeshLoadOptions opt;
   opt.scale = scale;
-  TriangleMesh mesh = load_mesh(path, opt);
-  t.description = fmt::format("mesh {} ({} triangles)", path.string(), mesh.triangles.size());
+  opt.repair_orientation = repair_orientation;
+  MeshReport report;
+  TriangleMesh mesh = load_mesh(path, opt, &report);
+  t.description = fmt::format("mesh {} ({} triangles{})", path.string(), mesh.triangles.size(),
+                              reoriented(report));
+  t.reoriented_faces = report.reoriented_faces;
   t.solid = std::make_unique<MeshSolid>(std::move(mesh));
   return t;
 }
@@ -62,7 +79,9 @@ TargetShape target_from_source(const ClumpTemplate& clump, const std::string& wh
   } else if (!mesh.empty() || (!file.empty() && is_mesh_file(file))) {
     const fs::path p = resolve(mesh.empty() ? file : mesh);
     try {
-      t = target_from_mesh(p, scale);
+      const auto repair = s.find("repair_orientation");
+      t = target_from_mesh(p, scale,
+                           repair != s.end() && repair->is_boolean() && repair->get<bool>());
     } catch (const InputError& e) {
       throw InputError(where, "source", "recorded mesh: " + std::string(e.what()));
     }

@@ -14,6 +14,8 @@ struct ShapeSpec {
   double height = 0.0;         ///< m (cylinder)
   std::filesystem::path mesh;  ///< mesh file, resolved against the shape file's folder
   double mesh_scale = 1.0;     ///< factor from mesh file units to metres
+  /// Re-orient the mesh's triangles if they disagree (`repair_orientation = true` under [shape]).
+  bool repair_orientation = false;
   std::string material = "pill";
   double density = 0.0;        ///< kg/m^3
   double mass_fraction = 1.0;  ///< share of the population by mass, (0, 1]

@@ -16,6 +16,10 @@ struct MeshLoadOptions {
   /// Refuse (InputError) meshes whose enclosed volume would be meaningless.
   bool require_closed = true;
   bool check_self_intersections = true;
+  /// Re-orient a closed, manifold mesh whose triangles disagree on orientation, or whose bodies
+  /// face against their nesting (orient_outward), instead of refusing it. The report counts the
+  /// triangles reversed (reoriented_faces).
+  bool repair_orientation = false;
 };
 
 /// True for the file names load_mesh reads: .stl .obj .ply .off, in any case.
@@ -24,7 +28,8 @@ bool is_mesh_file(const std::filesystem::path& path);
 /// Loads, welds and validates a mesh; flips it to outward orientation if its signed volume is
 /// negative. Throws InputError naming the file (and the defect counts) for a missing, empty,
 /// unreadable (or not .stl, .obj, .ply, .off: the format is chosen by the extension, in any case)
-/// or, with `require_closed`, an open/non-manifold/self-intersecting mesh.
+/// or, with `require_closed`, an open/non-manifold/self-intersecting mesh, or one whose orientation
+/// is inconsistent (unless `repair_orientation`).
 /// `report`, if given, receives the validation report of the returned mesh.
 TriangleMesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options,
                        MeshReport* report = nullptr);

@@ -18,13 +18,23 @@ struct MeshReport {
   std::size_t boundary_edges = 0;      ///< edges used by one triangle (open mesh)
   std::size_t nonmanifold_edges = 0;   ///< edges used by more than two triangles
   std::size_t inconsistent_edges = 0;  ///< edges whose two triangles disagree on orientation
-  std::size_t degenerate_faces = 0;    ///< (near-)zero area; harmless for volume, reported
+  std::size_t bodies = 0;              ///< connected components (counted on a closed manifold)
+  /// Bodies facing against their nesting: an inverted body beside others, or a cavity's wall
+  /// facing outward (clumpkit/mesh_io/orientation.hpp). Counted on a closed, consistent manifold.
+  std::size_t misoriented_bodies = 0;
+  std::size_t degenerate_faces = 0;  ///< (near-)zero area; harmless for volume, reported
   /// Pairs of triangles that intersect other than at shared edges/vertices; -1 when not checked
   /// (disabled, or the mesh is not a closed oriented manifold, which CGAL's check requires).
   long long self_intersections = -1;
-  double signed_volume = 0.0;  ///< m^3, positive for outward orientation
-  double area = 0.0;           ///< m^2
-  bool flipped = false;        ///< orientation was reversed to make it outward (loading only)
+  double signed_volume = 0.0;        ///< m^3, positive for outward orientation
+  double area = 0.0;                 ///< m^2
+  bool flipped = false;              ///< orientation was reversed to make it outward (loading only)
+  std::size_t reoriented_faces = 0;  ///< triangles reversed by the orientation repair (loading)
+
+  /// True when the only defects found are orientations: a closed manifold whose triangles can be
+  /// re-oriented (MeshLoadOptions::repair_orientation). Self-intersections are only counted on a
+  /// consistent mesh, so one may still be found after the repair.
+  bool orientation_repairable() const;
 
   /// True when the mesh bounds a solid whose volume and moments mean something.
   bool closed_solid() const;
@@ -41,7 +51,8 @@ struct MeshValidateOptions {
 /// Counts the defects of `mesh` without modifying it.
 MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidateOptions& options = {});
 
-/// Throws InputError(where, "", "<defects>: not a closed solid") unless report.closed_solid().
+/// Throws InputError(where, "", "<defects>: not a closed solid") unless report.closed_solid();
+/// when the orientation is the only defect, the message says how to ask for the repair.
 void require_closed_solid(const MeshReport& report, const std::string& where);
 
 }  // namespace clumpkit
