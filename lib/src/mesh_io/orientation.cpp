@@ -31,7 +31,8 @@ int find_root(std::vector<int>& parent, int v) {
   return v;
 }
 
-Bodies find_bodies(const TriangleMesh& mesh) {
+// With `geometry` false only the labels and the count (enough to see a mesh of one body).
+Bodies find_bodies(const TriangleMesh& mesh, bool geometry = true) {
   const int nv = static_cast<int>(mesh.vertices.size());
   std::vector<int> parent(nv);
   std::iota(parent.begin(), parent.end(), 0);
@@ -49,6 +50,7 @@ Bodies find_bodies(const TriangleMesh& mesh) {
     if (body < 0) body = b.n++;
     b.of_triangle[f] = body;
   }
+  if (!geometry) return b;
   b.start.assign(b.n + 1, 0);
   for (int c : b.of_triangle) ++b.start[c + 1];
   std::partial_sum(b.start.begin(), b.start.end(), b.start.begin());
@@ -109,10 +111,10 @@ std::uint64_t edge_key(int a, int b) {
 }  // namespace
 
 BodyOrientation body_orientation(const TriangleMesh& mesh) {
-  const Bodies b = find_bodies(mesh);
   BodyOrientation r;
-  r.bodies = static_cast<std::size_t>(b.n);
-  if (b.n < 2) return r;
+  r.bodies = static_cast<std::size_t>(find_bodies(mesh, false).n);
+  if (r.bodies < 2) return r;
+  const Bodies b = find_bodies(mesh);
   // The fewest bodies to turn, the whole mesh's orientation being free (load_mesh flips a mesh
   // whose total volume is negative).
   const std::vector<int> depth = nesting_depths(mesh, b);
