@@ -1,5 +1,7 @@
 #include "cli_util.hpp"
 
+#include <fmt/format.h>
+
 #include <cstdlib>
 #include <iostream>
 
@@ -38,6 +40,19 @@ fs::path find_model(const std::string& arg, const std::string& field) {
       known += (known.empty() ? "" : ", ") + e.path().stem().string();
   throw InputError("", field,
                    "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
+}
+
+void warn_if_mesh_units_suspect(const std::string& file, double extent, const std::string& units) {
+  if (extent > 0.5)
+    std::cerr << fmt::format(
+        "clumpkit: warning: {} is {:.4g} m across, read in {}: if the file is in millimetres, "
+        "give --mesh-units mm\n",
+        file, extent, units);
+  else if (extent < 50e-6)
+    std::cerr << fmt::format(
+        "clumpkit: warning: {} is {:.4g} mm across, read in {}: check --mesh-units (the file's "
+        "length unit)\n",
+        file, extent * 1e3, units);
 }
 
 void write_json(const nlohmann::json& j, const std::string& target) {

@@ -20,6 +20,11 @@ std::filesystem::path find_model(const std::string& arg, const std::string& fiel
 /// Writes JSON to a file (atomically) or to stdout for "-".
 void write_json(const nlohmann::json& j, const std::string& target);
 
+/// A warning on stderr when a mesh read with --mesh-units `units` is implausibly large (over
+/// 0.5 m across) or small (under 50 µm) for a particle: most CAD and scan files are in
+/// millimetres, and the default unit is the metre. `extent` is the largest side of its bounds, m.
+void warn_if_mesh_units_suspect(const std::string& file, double extent, const std::string& units);
+
 /// A command registers itself on the app; the returned callback runs it and returns the exit code.
 using Runner = std::function<int()>;
 struct Command {

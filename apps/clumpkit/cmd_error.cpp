@@ -76,6 +76,7 @@ Row analyse(const std::string& path, const ErrorArgs& a) {
     target =
         target_from_mesh(a.shape, unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units"),
                          a.repair_orientation);
+    warn_if_mesh_units_suspect(a.shape, target.solid->bounds().sizes().maxCoeff(), a.mesh_units);
   } else {
     ShapeSpec spec = load_shape(resolve_shape(a.shape));
     spec.repair_orientation = spec.repair_orientation || a.repair_orientation;

@@ -54,6 +54,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     const double scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
     TargetShape t = target_from_mesh(a.shape, scale, a.repair_orientation);
     note_reoriented(t);
+    warn_if_mesh_units_suspect(a.shape, t.solid->bounds().sizes().maxCoeff(), a.mesh_units);
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
     if (a.repair_orientation) source["repair_orientation"] = true;

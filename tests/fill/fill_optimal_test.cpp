@@ -316,6 +316,17 @@ TEST(FillCli, InconsistentlyOrientedMeshIsRefusedOrRepairedOnRequest) {
   EXPECT_EQ(j.at("source").at("repair_orientation"), true);
   EXPECT_LT(j.at("error").at("symmetric_difference").at("value").get<double>(), 0.5);
   EXPECT_EQ(run("error " + out.string() + " --rays 20000"), 0) << last_error();
+  // The same millimetre file read in metres (the default unit): filled, with a warning naming
+  // the flag (the torus is 8.4 mm across).
+  const auto metres = scratch("scrambled_torus_m.json");
+  ASSERT_EQ(run("fill " + mesh.string() + " --method edt --spheres 4 --repair-orientation -o " +
+                metres.string()),
+            0)
+      << last_error();
+  EXPECT_NE(last_error().find("is 8.4 m across, read in m: if the file is in millimetres, give "
+                              "--mesh-units mm"),
+            std::string::npos)
+      << last_error();
 }
 
 // Real-world meshes from a Debian package (libcgal-demo: CGAL's data archive), read at test time:
