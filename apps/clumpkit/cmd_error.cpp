@@ -28,7 +28,7 @@ struct ErrorArgs {
   std::size_t samples = ShapeErrorOptions{}.surface_samples;
   int replicates = RaySamplingOptions{}.replicates;
   bool table = false;
-  bool repair_orientation = false;
+  bool repair_orientation = false, repair_holes = false;
 };
 
 struct Row {
@@ -73,13 +73,16 @@ Row analyse(const std::string& path, const ErrorArgs& a) {
              !path_exists(data_dir() / "shapes" / (a.shape + ".toml"))) {
     target = target_from_test_shape(a.shape, 1);
   } else if (is_mesh_file(a.shape)) {
-    target =
-        target_from_mesh(a.shape, unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units"),
-                         a.repair_orientation);
+    MeshLoadOptions load;
+    load.scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
+    load.repair_orientation = a.repair_orientation;
+    load.repair_holes = a.repair_holes;
+    target = target_from_mesh(a.shape, load);
     warn_if_mesh_units_suspect(a.shape, target.solid->bounds().sizes().maxCoeff(), a.mesh_units);
   } else {
     ShapeSpec spec = load_shape(resolve_shape(a.shape));
     spec.repair_orientation = spec.repair_orientation || a.repair_orientation;
+    spec.repair_holes = spec.repair_holes || a.repair_holes;
     target = target_from_shape(spec);
   }
   ShapeErrorOptions opt;
@@ -263,6 +266,9 @@ Command setup_error(CLI::App& parent) {
   c->add_flag("--repair-orientation", a->repair_orientation,
               "Re-orient a --shape mesh (closed, manifold) whose triangles disagree on "
               "orientation instead of refusing it (a template's recorded mesh: as it was filled)");
+  c->add_flag("--repair-holes", a->repair_holes,
+              "Close the holes of an open, manifold --shape mesh, then orient it, instead of "
+              "refusing it (a template's recorded mesh: as it was filled)");
   c->add_option("--rays", a->rays, "Rays in total (3 axes x replicates)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{2'000'000'000}));
   c->add_option("--seed", a->seed, "Seed of the ray jitter and surface samples");

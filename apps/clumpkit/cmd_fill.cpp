@@ -31,13 +31,20 @@ struct FillArgs {
   double max_error = 0.0;
   std::string metric = "symmetric_difference", min_radius, tolerance, mesh_units = "m", density;
   int grid = FillOptions{}.grid;
-  bool repair_orientation = false;
+  bool repair_orientation = false, repair_holes = false;
 };
 
-// A note on stderr when the loader re-oriented the mesh's triangles (--repair-orientation).
-void note_reoriented(const TargetShape& t) {
-  if (t.reoriented_faces > 0)
-    std::cerr << fmt::format("clumpkit: note: re-oriented the triangles of {}\n", t.description);
+// A note on stderr when the loader repaired the mesh (--repair-orientation, --repair-holes), and
+// a warning when the holes it closed are a large part of the surface (the shape is then partly
+// invented: a bowl is closed by a lid).
+void note_repairs(const TargetShape& t) {
+  if (t.reoriented_faces == 0 && t.holes_filled == 0) return;
+  std::cerr << fmt::format("clumpkit: note: repaired {}\n", t.description);
+  if (t.hole_area_fraction > 0.05)
+    std::cerr << fmt::format(
+        "clumpkit: warning: the closed holes are {:.0f} % of the surface: the filled shape is "
+        "partly made up; check it (clumpkit error, or the template's VTK export)\n",
+        100 * t.hole_area_fraction);
 }
 
 // The shape of an edt/optimal fill: a mesh file, a shape file (or bundled shape), or a test shape
@@ -52,12 +59,17 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
 #ifdef CLUMPKIT_HAVE_RAYCAST  // Embree is required (lib/src/raycast): every build has it
   if (is_mesh_file(a.shape)) {
     const double scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
-    TargetShape t = target_from_mesh(a.shape, scale, a.repair_orientation);
-    note_reoriented(t);
+    MeshLoadOptions load;
+    load.scale = scale;
+    load.repair_orientation = a.repair_orientation;
+    load.repair_holes = a.repair_holes;
+    TargetShape t = target_from_mesh(a.shape, load);
+    note_repairs(t);
     warn_if_mesh_units_suspect(a.shape, t.solid->bounds().sizes().maxCoeff(), a.mesh_units);
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
     if (a.repair_orientation) source["repair_orientation"] = true;
+    if (a.repair_holes) source["repair_holes"] = true;
     return from_surface(solid, a.shape);
   }
 #endif
@@ -78,6 +90,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   }
   ShapeSpec spec = load_shape(resolve_shape(a.shape));
   spec.repair_orientation = spec.repair_orientation || a.repair_orientation;
+  spec.repair_holes = spec.repair_holes || a.repair_holes;
   density = spec.density;
   source = {{"shape", spec.name},
             {"file", spec.path.string()},
@@ -95,12 +108,13 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   }
 #ifdef CLUMPKIT_HAVE_RAYCAST
   TargetShape t = target_from_shape(spec);
-  note_reoriented(t);
+  note_repairs(t);
   std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
   source["kind"] = "mesh";
   source["mesh"] = spec.mesh.string();
   source["mesh_scale"] = spec.mesh_scale;
   if (spec.repair_orientation) source["repair_orientation"] = true;
+  if (spec.repair_holes) source["repair_holes"] = true;
   return from_surface(solid, spec.path.string());
 #else
   throw InputError(spec.path.string(), "shape.kind", "this build has no mesh support (raycast)");
@@ -184,6 +198,9 @@ Command setup_fill(CLI::App& parent) {
   c->add_flag("--repair-orientation", args->repair_orientation,
               "edt/optimal: re-orient a closed, manifold mesh whose triangles disagree on "
               "orientation (or whose bodies face inward) instead of refusing it");
+  c->add_flag("--repair-holes", args->repair_holes,
+              "edt/optimal: close the holes of an open, manifold mesh (a scan's gaps) with CGAL's "
+              "hole triangulation, then orient it, instead of refusing it");
   c->add_option("--density", args->density,
                 "edt/optimal: density (\"1380 kg/m^3\"; default the shape file's, else 1380)");
   c->add_option("--grid", args->grid, "edt/optimal: distance-grid cells along the longest side")

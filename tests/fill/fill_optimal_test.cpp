@@ -329,6 +329,32 @@ TEST(FillCli, InconsistentlyOrientedMeshIsRefusedOrRepairedOnRequest) {
       << last_error();
 }
 
+// An open mesh (a scan with gaps: the torus with the triangles around two vertices removed):
+// refused with exit 2 naming --repair-holes; with it, filled, the repair noted and recorded, and
+// `clumpkit error` re-reads the mesh the same way.
+TEST(FillCli, HoleyMeshIsRefusedOrClosedOnRequest) {
+  TessellatedMesh t = make_test_shape("torus")->tessellate(3000);
+  for (const int centre : {0, static_cast<int>(t.vertices.size()) / 2})
+    std::erase_if(t.triangles, [&](const std::array<int, 3>& f) {
+      return f[0] == centre || f[1] == centre || f[2] == centre;
+    });
+  const auto mesh = scratch("holey_torus.stl"), out = scratch("holey_torus.json");
+  std::ofstream(mesh) << to_ascii_stl(t, "holey", 1000.0);  // millimetres
+  const std::string fill =
+      "fill " + mesh.string() + " --mesh-units mm --method optimal --spheres 6 -o " + out.string();
+  EXPECT_EQ(run(fill), 2);
+  EXPECT_NE(last_error().find("boundary (open) edges"), std::string::npos) << last_error();
+  EXPECT_NE(last_error().find("--repair-holes"), std::string::npos) << last_error();
+  EXPECT_FALSE(std::filesystem::exists(out));
+  ASSERT_EQ(run(fill + " --repair-holes"), 0) << last_error();
+  EXPECT_NE(last_error().find("2 holes closed"), std::string::npos) << last_error();
+  std::ifstream in(out);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("source").at("repair_holes"), true);
+  EXPECT_LT(j.at("error").at("symmetric_difference").at("value").get<double>(), 0.5);
+  EXPECT_EQ(run("error " + out.string() + " --rays 20000"), 0) << last_error();
+}
+
 // Real-world meshes from a Debian package (libcgal-demo: CGAL's data archive), read at test time:
 // a scanned elephant and cow and a CAD anchor fill through the mesh path, and the optimiser beats
 // the EDT baseline on each at 12 spheres; a scan with self-intersecting triangles (the bull) is

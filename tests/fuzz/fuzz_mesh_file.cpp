@@ -3,8 +3,8 @@
 // name's extension (which selects the reader: 'o' .obj, 'p' .ply, 'f' .off, anything else .stl);
 // the rest is the file, written to a per-process file under /dev/shm (the readers take paths). Each
 // input is loaded three times: as a shape (closed solid required, self-intersections checked), as a
-// shape whose orientation may be repaired, and as a wall (open surfaces allowed), and what an
-// accepted mesh promises is checked.
+// shape whose holes and orientation may be repaired, and as a wall (open surfaces allowed), and
+// what an accepted mesh promises is checked.
 #include <unistd.h>
 
 #include <cmath>
@@ -54,7 +54,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
   }
-  // As a shape, as a shape with its orientation repaired on request, and as a wall.
+  // As a shape, as a shape with its holes and orientation repaired on request, and as a wall.
   for (const int mode : {0, 1, 2}) {
     const bool closed = mode < 2;
     fuzz::input_errors_only([&] {
@@ -62,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       o.scale = 0.001;
       o.require_closed = closed;
       o.check_self_intersections = closed;
-      o.repair_orientation = mode == 1;
+      o.repair_orientation = o.repair_holes = mode == 1;
       MeshReport r;
       const TriangleMesh m = load_mesh(path, o, &r);
       check_mesh(m, r, closed);

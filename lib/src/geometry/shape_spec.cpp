@@ -28,6 +28,7 @@ ShapeSpec parse_shape(const std::string& text, const std::filesystem::path& path
     const std::string unit = doc.string_opt("shape.units").value_or("m");
     s.mesh_scale = unit_factor(unit, Dimension::Length, path.string(), "shape.units");
     s.repair_orientation = doc.boolean_opt("shape.repair_orientation").value_or(false);
+    s.repair_holes = doc.boolean_opt("shape.repair_holes").value_or(false);
   } else {
     doc.fail("shape.kind", "unknown kind '" + kind + "' (expected cylinder or mesh)");
   }

@@ -15,6 +15,7 @@
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/mesh_io/orientation.hpp"
+#include "hole_filling.hpp"
 #include "mesh_readers.hpp"
 
 namespace clumpkit {
@@ -140,6 +141,20 @@ TriangleMesh read_with_assimp(const fs::path& path, const std::string& where) {
   return mesh;
 }
 
+// How many of the triangles `before` run the other way round in `after` (same positions; `after`
+// may have more).
+std::size_t reversed_count(const std::vector<Eigen::Vector3i>& before,
+                           const std::vector<Eigen::Vector3i>& after) {
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < before.size(); ++f) {
+    const Eigen::Vector3i& a = before[f];
+    const Eigen::Vector3i& b = after[f];
+    n += !(b == a || b == Eigen::Vector3i(a[1], a[2], a[0]) ||
+           b == Eigen::Vector3i(a[2], a[0], a[1]));
+  }
+  return n;
+}
+
 }  // namespace
 
 bool is_mesh_file(const fs::path& path) {
@@ -185,7 +200,17 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& opt, MeshRep
   MeshValidateOptions vopt;
   vopt.check_self_intersections = opt.check_self_intersections;
   MeshReport r = validate_mesh(mesh, vopt);
-  if (opt.repair_orientation && r.orientation_repairable()) {
+  if (opt.repair_holes && r.holes_repairable()) {
+    const std::vector<Eigen::Vector3i> before = mesh.triangles;
+    orient_consistently(mesh, where);
+    const detail::FilledHoles h = detail::fill_holes(mesh, where, opt.max_hole_edges);
+    orient_outward(mesh, where);
+    r = validate_mesh(mesh, vopt);
+    r.holes_filled = h.holes;
+    r.triangles_added = h.triangles_added;
+    r.hole_area = h.area_added;
+    r.reoriented_faces = reversed_count(before, mesh.triangles);
+  } else if ((opt.repair_orientation || opt.repair_holes) && r.orientation_repairable()) {
     const std::size_t reversed = orient_outward(mesh, where);
     r = validate_mesh(mesh, vopt);
     r.reoriented_faces = reversed;
@@ -218,6 +243,7 @@ TriangleMesh load_shape_mesh(const ShapeSpec& shape, MeshReport* report) {
   MeshLoadOptions opt;
   opt.scale = shape.mesh_scale;
   opt.repair_orientation = shape.repair_orientation;
+  opt.repair_holes = shape.repair_holes;
   return load_mesh(shape.mesh, opt, report);
 }
 

@@ -18,6 +18,11 @@ bool MeshReport::closed_solid() const {
          self_intersections <= 0 && signed_volume != 0.0;
 }
 
+bool MeshReport::holes_repairable() const {
+  return triangles > 0 && nonfinite_vertices == 0 && bad_indices == 0 && boundary_edges > 0 &&
+         nonmanifold_edges == 0;
+}
+
 bool MeshReport::orientation_repairable() const {
   return triangles > 0 && nonfinite_vertices == 0 && bad_indices == 0 && boundary_edges == 0 &&
          nonmanifold_edges == 0 && self_intersections <= 0 &&
@@ -118,6 +123,10 @@ void require_closed_solid(const MeshReport& report, const std::string& where) {
     hint =
         "; it is closed and manifold, so its triangles can be re-oriented: give "
         "--repair-orientation (a shape file: repair_orientation = true under [shape])";
+  else if (report.holes_repairable())
+    hint =
+        "; it is manifold, so its holes can be closed: give --repair-holes (a shape file: "
+        "repair_holes = true under [shape])";
   throw InputError(where, "",
                    fmt::format("{} ({} vertices, {} triangles): not a closed solid, its volume "
                                "would be meaningless{}",

@@ -128,11 +128,17 @@ BodyOrientation body_orientation(const TriangleMesh& mesh) {
   return r;
 }
 
-std::size_t orient_outward(TriangleMesh& mesh, const std::string& where) {
+namespace {
+
+// The reversals that make neighbouring triangles agree (1: reverse), by a breadth-first walk over
+// the triangles: a neighbour must run their shared edge the other way. Edges of one triangle
+// (boundary) are allowed only with `allow_boundary`.
+std::vector<signed char> consistent_flips(const TriangleMesh& mesh, const std::string& where,
+                                          bool allow_boundary) {
   const std::size_t nt = mesh.triangles.size();
   const auto nv = static_cast<long long>(mesh.vertices.size());
-  // Each undirected edge's two uses: triangle and direction (+1 when it runs from the lower
-  // vertex index to the higher).
+  // Each undirected edge's uses: triangle and direction (+1 when it runs from the lower vertex
+  // index to the higher).
   struct Uses {
     int n = 0;
     std::array<int, 2> tri{};
@@ -152,14 +158,17 @@ std::size_t orient_outward(TriangleMesh& mesh, const std::string& where) {
       ++u.n;
     }
   }
-  std::size_t unshared = 0;
-  for (const auto& [key, u] : edges) unshared += u.n != 2;
-  if (unshared > 0)
+  std::size_t bad = 0;
+  for (const auto& [key, u] : edges) bad += u.n > 2 || (u.n == 1 && !allow_boundary);
+  if (bad > 0)
     throw InputError(where, "",
-                     fmt::format("{} edges are not shared by exactly two triangles: only a closed, "
-                                 "manifold surface can be re-oriented",
-                                 unshared));
-  // Breadth-first over the triangles: a neighbour must run their shared edge the other way.
+                     allow_boundary
+                         ? fmt::format("{} edges are shared by more than two triangles: only a "
+                                       "manifold surface can be oriented",
+                                       bad)
+                         : fmt::format("{} edges are not shared by exactly two triangles: only a "
+                                       "closed, manifold surface can be re-oriented",
+                                       bad));
   std::vector<signed char> flip(nt, -1);
   std::vector<int> queue;
   queue.reserve(nt);
@@ -172,6 +181,7 @@ std::size_t orient_outward(TriangleMesh& mesh, const std::string& where) {
       const Eigen::Vector3i& t = mesh.triangles[f];
       for (int k = 0; k < 3; ++k) {
         const Uses& u = edges.at(edge_key(t[k], t[(k + 1) % 3]));
+        if (u.n < 2) continue;  // a boundary edge: no neighbour across it
         const int side = u.tri[0] == f ? 0 : 1;
         const int g = u.tri[1 - side];
         const int mine = u.dir[side] * (flip[f] ? -1 : 1);
@@ -184,14 +194,32 @@ std::size_t orient_outward(TriangleMesh& mesh, const std::string& where) {
   // the body is one-sided.
   std::size_t conflicts = 0;
   for (const auto& [key, u] : edges)
-    conflicts += u.dir[0] * (flip[u.tri[0]] ? -1 : 1) == u.dir[1] * (flip[u.tri[1]] ? -1 : 1);
+    conflicts +=
+        u.n == 2 && u.dir[0] * (flip[u.tri[0]] ? -1 : 1) == u.dir[1] * (flip[u.tri[1]] ? -1 : 1);
   if (conflicts > 0)
     throw InputError(where, "",
                      fmt::format("the surface is not orientable ({} edges where its triangles "
                                  "cannot agree on a side): it is one-sided and bounds no volume",
                                  conflicts));
-  for (std::size_t f = 0; f < nt; ++f)
-    if (flip[f]) std::swap(mesh.triangles[f][1], mesh.triangles[f][2]);
+  return flip;
+}
+
+std::size_t apply_flips(TriangleMesh& mesh, const std::vector<signed char>& flip) {
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    if (flip[f]) std::swap(mesh.triangles[f][1], mesh.triangles[f][2]), ++n;
+  return n;
+}
+
+}  // namespace
+
+std::size_t orient_consistently(TriangleMesh& mesh, const std::string& where) {
+  return apply_flips(mesh, consistent_flips(mesh, where, true));
+}
+
+std::size_t orient_outward(TriangleMesh& mesh, const std::string& where) {
+  std::vector<signed char> flip = consistent_flips(mesh, where, false);
+  apply_flips(mesh, flip);
   // Every body is now consistent; turn each to face outward by its nesting.
   const Bodies b = find_bodies(mesh);
   const std::vector<int> depth = nesting_depths(mesh, b);
@@ -201,7 +229,7 @@ std::size_t orient_outward(TriangleMesh& mesh, const std::string& where) {
     turn[c] = b.volume[c] * want < 0.0;
   }
   std::size_t reversed = 0;
-  for (std::size_t f = 0; f < nt; ++f) {
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     if (turn[b.of_triangle[f]]) {
       std::swap(mesh.triangles[f][1], mesh.triangles[f][2]);
       flip[f] = static_cast<signed char>(!flip[f]);

@@ -1,7 +1,7 @@
 #pragma once
-// The one CGAL-using unit of clumpkit: triangle-triangle self-intersection counting
-// (CGAL::Polygon_mesh_processing). Kept behind this plain interface so CGAL's headers never
-// reach another translation unit.
+// One of the two CGAL-using units of clumpkit (with hole_filling.hpp): triangle-triangle
+// self-intersection counting (CGAL::Polygon_mesh_processing). Kept behind this plain interface so
+// CGAL's headers never reach another translation unit.
 #include "clumpkit/mesh_io/triangle_mesh.hpp"
 
 namespace clumpkit::detail {

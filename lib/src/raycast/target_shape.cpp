@@ -15,10 +15,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// ", 12 of them re-oriented" when the loader repaired the orientation.
-std::string reoriented(const MeshReport& r) {
-  return r.reoriented_faces > 0 ? fmt::format(", {} of them re-oriented", r.reoriented_faces)
-                                : std::string();
+// What the loader repaired, for the description: ", 3 holes closed with 41 triangles (0.8 % of
+// the surface), 12 re-oriented", or nothing.
+std::string repairs(const MeshReport& r) {
+  std::string s;
+  if (r.holes_filled > 0)
+    s += fmt::format(", {} hole{} closed with {} triangles ({:.2g} % of the surface)",
+                     r.holes_filled, r.holes_filled == 1 ? "" : "s", r.triangles_added,
+                     r.area > 0 ? 100.0 * r.hole_area / r.area : 0.0);
+  if (r.reoriented_faces > 0) s += fmt::format(", {} re-oriented", r.reoriented_faces);
+  return s;
+}
+
+void note_repairs(TargetShape& t, const MeshReport& r) {
+  t.reoriented_faces = r.reoriented_faces;
+  t.holes_filled = r.holes_filled;
+  t.hole_area_fraction = r.area > 0 ? r.hole_area / r.area : 0.0;
 }
 
 }  // namespace
@@ -34,22 +46,25 @@ TargetShape target_from_shape(const ShapeSpec& shape) {
     MeshReport report;
     t.solid = std::make_unique<MeshSolid>(load_shape_mesh(shape, &report));
     t.description = fmt::format("{}: mesh {} ({} triangles{})", shape.name, shape.mesh.string(),
-                                report.triangles, reoriented(report));
-    t.reoriented_faces = report.reoriented_faces;
+                                report.triangles, repairs(report));
+    note_repairs(t, report);
   }
   return t;
 }
 
-TargetShape target_from_mesh(const fs::path& path, double scale, bool repair_orientation) {
-  TargetShape t;
+TargetShape target_from_mesh(const fs::path& path, double scale) {
   MeshLoadOptions opt;
   opt.scale = scale;
-  opt.repair_orientation = repair_orientation;
+  return target_from_mesh(path, opt);
+}
+
+TargetShape target_from_mesh(const fs::path& path, const MeshLoadOptions& opt) {
+  TargetShape t;
   MeshReport report;
   TriangleMesh mesh = load_mesh(path, opt, &report);
   t.description = fmt::format("mesh {} ({} triangles{})", path.string(), mesh.triangles.size(),
-                              reoriented(report));
-  t.reoriented_faces = report.reoriented_faces;
+                              repairs(report));
+  note_repairs(t, report);
   t.solid = std::make_unique<MeshSolid>(std::move(mesh));
   return t;
 }
@@ -79,9 +94,15 @@ TargetShape target_from_source(const ClumpTemplate& clump, const std::string& wh
   } else if (!mesh.empty() || (!file.empty() && is_mesh_file(file))) {
     const fs::path p = resolve(mesh.empty() ? file : mesh);
     try {
-      const auto repair = s.find("repair_orientation");
-      t = target_from_mesh(p, scale,
-                           repair != s.end() && repair->is_boolean() && repair->get<bool>());
+      auto flag = [&](const char* key) {
+        const auto it = s.find(key);
+        return it != s.end() && it->is_boolean() && it->get<bool>();
+      };
+      MeshLoadOptions opt;
+      opt.scale = scale;
+      opt.repair_orientation = flag("repair_orientation");
+      opt.repair_holes = flag("repair_holes");
+      t = target_from_mesh(p, opt);
     } catch (const InputError& e) {
       throw InputError(where, "source", "recorded mesh: " + std::string(e.what()));
     }

@@ -16,6 +16,8 @@ struct ShapeSpec {
   double mesh_scale = 1.0;     ///< factor from mesh file units to metres
   /// Re-orient the mesh's triangles if they disagree (`repair_orientation = true` under [shape]).
   bool repair_orientation = false;
+  /// Close the mesh's holes (`repair_holes = true` under [shape]); implies the orientation repair.
+  bool repair_holes = false;
   std::string material = "pill";
   double density = 0.0;        ///< kg/m^3
   double mass_fraction = 1.0;  ///< share of the population by mass, (0, 1]

@@ -20,6 +20,11 @@ struct MeshLoadOptions {
   /// face against their nesting (orient_outward), instead of refusing it. The report counts the
   /// triangles reversed (reoriented_faces).
   bool repair_orientation = false;
+  /// Close the holes of an open, manifold mesh (boundary loops, e.g. of a scan) with CGAL's hole
+  /// triangulation, then re-orient it as repair_orientation does. Loops longer than
+  /// `max_hole_edges` are refused. The report counts the holes and the triangles added.
+  bool repair_holes = false;
+  std::size_t max_hole_edges = 1000;
 };
 
 /// True for the file names load_mesh reads: .stl .obj .ply .off, in any case.

@@ -30,11 +30,17 @@ struct MeshReport {
   double area = 0.0;                 ///< m^2
   bool flipped = false;              ///< orientation was reversed to make it outward (loading only)
   std::size_t reoriented_faces = 0;  ///< triangles reversed by the orientation repair (loading)
+  std::size_t holes_filled = 0;      ///< boundary loops closed by the hole repair (loading)
+  std::size_t triangles_added = 0;   ///< triangles the hole repair added (loading)
+  double hole_area = 0.0;            ///< m^2, area of those triangles (loading)
 
   /// True when the only defects found are orientations: a closed manifold whose triangles can be
   /// re-oriented (MeshLoadOptions::repair_orientation). Self-intersections are only counted on a
   /// consistent mesh, so one may still be found after the repair.
   bool orientation_repairable() const;
+  /// True when the mesh is open but otherwise manifold: its holes can be closed
+  /// (MeshLoadOptions::repair_holes).
+  bool holes_repairable() const;
 
   /// True when the mesh bounds a solid whose volume and moments mean something.
   bool closed_solid() const;

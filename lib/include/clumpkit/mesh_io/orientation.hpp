@@ -31,4 +31,10 @@ BodyOrientation body_orientation(const TriangleMesh& mesh);
 /// exactly two triangles or a body is not orientable (a Möbius-like surface), with the counts.
 std::size_t orient_outward(TriangleMesh& mesh, const std::string& where);
 
+/// Makes neighbouring triangles agree on orientation on a manifold mesh that may be open (edges
+/// of one triangle allowed), each body's orientation taken from its first triangle. Returns the
+/// number of triangles reversed. Throws InputError as orient_outward for an edge of more than two
+/// triangles or a one-sided surface.
+std::size_t orient_consistently(TriangleMesh& mesh, const std::string& where);
+
 }  // namespace clumpkit
