@@ -4,6 +4,7 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/exceptions.h>
 #include <fmt/format.h>
 
 #include <array>
@@ -14,7 +15,10 @@
 
 namespace clumpkit::detail {
 
-FilledHoles fill_holes(TriangleMesh& mesh, const std::string& where, std::size_t max_edges) {
+namespace {
+
+FilledHoles fill_holes_with_cgal(TriangleMesh& mesh, const std::string& where,
+                                 std::size_t max_edges) {
   using K = CGAL::Exact_predicates_inexact_constructions_kernel;
   using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
   namespace PMP = CGAL::Polygon_mesh_processing;
@@ -61,9 +65,8 @@ FilledHoles fill_holes(TriangleMesh& mesh, const std::string& where, std::size_t
     // exhaustive search, cubic in the loop's length, only for loops of at most kCubicEdges (a
     // millisecond there; minutes for a loop of a few hundred edges).
     constexpr std::size_t kCubicEdges = 100;
-    PMP::triangulate_hole(
-        sm, loops[k], std::back_inserter(added),
-        CGAL::parameters::do_not_use_cubic_algorithm(lengths[k] > kCubicEdges));
+    PMP::triangulate_hole(sm, loops[k], std::back_inserter(added),
+                          CGAL::parameters::do_not_use_cubic_algorithm(lengths[k] > kCubicEdges));
     if (added.empty())
       throw InputError(
           where, "",
@@ -86,6 +89,19 @@ FilledHoles fill_holes(TriangleMesh& mesh, const std::string& where, std::size_t
     ++out.holes;
   }
   return out;
+}
+
+}  // namespace
+
+FilledHoles fill_holes(TriangleMesh& mesh, const std::string& where, std::size_t max_edges) {
+  // CGAL reports a broken precondition by an exception of its own (with its checks on, as in the
+  // sanitizer builds): a mesh it cannot take, said as such.
+  try {
+    return fill_holes_with_cgal(mesh, where, max_edges);
+  } catch (const CGAL::Failure_exception& e) {
+    throw InputError(where, "",
+                     "cannot fill its holes: CGAL refused the mesh (" + e.message() + ")");
+  }
 }
 
 }  // namespace clumpkit::detail
