@@ -33,8 +33,9 @@ bool is_mesh_file(const std::filesystem::path& path);
 /// Loads, welds and validates a mesh; flips it to outward orientation if its signed volume is
 /// negative. Throws InputError naming the file (and the defect counts) for a missing, empty,
 /// unreadable (or not .stl, .obj, .ply, .off: the format is chosen by the extension, in any case)
-/// or, with `require_closed`, an open/non-manifold/self-intersecting mesh, or one whose orientation
-/// is inconsistent (unless `repair_orientation`).
+/// or, with `require_closed`, a non-manifold or self-intersecting mesh, an open one (unless
+/// `repair_holes` closes it) or one whose orientation is inconsistent (unless `repair_orientation`
+/// or `repair_holes` re-orients it).
 /// `report`, if given, receives the validation report of the returned mesh.
 TriangleMesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options,
                        MeshReport* report = nullptr);

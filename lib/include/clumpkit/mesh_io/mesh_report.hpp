@@ -58,7 +58,8 @@ struct MeshValidateOptions {
 MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidateOptions& options = {});
 
 /// Throws InputError(where, "", "<defects>: not a closed solid") unless report.closed_solid();
-/// when the orientation is the only defect, the message says how to ask for the repair.
+/// when a repair would help (the orientation, or the holes of a manifold mesh), the message says
+/// how to ask for it.
 void require_closed_solid(const MeshReport& report, const std::string& where);
 
 }  // namespace clumpkit
