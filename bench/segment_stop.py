@@ -2,7 +2,8 @@
 """Adds a benchmark stop to a copy of lib/src/dem/step.cpp (bench/segment_bench.sh uses it on a
 temporary worktree; the repository's engine has no such hook). With CLUMPKIT_SEGMENT_STEPS=N in
 the environment, World::step prints, after its N-th step, the stage times so far and the state
-hash, then times each stage 300 more times on that state and exits. With
+hash, then times each stage 300 more times on that state (not with CLUMPKIT_SEGMENT_NO_TIMING set:
+bench/callgrind_segment.sh counts the steps alone) and exits. With
 CLUMPKIT_SEGMENT_SKIN=F the default Verlet skin is F times the smallest sphere radius instead of
 0.3 (lib/src/dem/world.cpp, patched beside step.cpp): the lists change, the results do not."""
 import os
@@ -49,10 +50,12 @@ stop = r'''  ++w.profile.steps;
       std::fprintf(stderr, "  %-18s min %8.1f us, quartile %8.1f us, median %8.1f us\n", name,
                    v[0], v[75], v[150]);
     };
-    timeit("detect_contacts", [&] { w.detect_contacts(); });
-    timeit("compute_forces", [&] { w.compute_forces(w.dt); });
-    timeit("kick_and_drift", [&] { w.kick_and_drift(); });
-    timeit("rebuild_neighbours", [&] { w.rebuild_neighbours(); });
+    if (!std::getenv("CLUMPKIT_SEGMENT_NO_TIMING")) {
+      timeit("detect_contacts", [&] { w.detect_contacts(); });
+      timeit("compute_forces", [&] { w.compute_forces(w.dt); });
+      timeit("kick_and_drift", [&] { w.kick_and_drift(); });
+      timeit("rebuild_neighbours", [&] { w.rebuild_neighbours(); });
+    }
     std::fflush(stderr);
     std::_Exit(0);
   }
