@@ -40,7 +40,7 @@ CLUMPKIT_SEGMENT_STEPS=$steps CLUMPKIT_SEGMENT_NO_TIMING=1 valgrind --tool=callg
   "$work/build/apps/clumpkit/clumpkit" rig "$@" --threads 1 --out "$work/run" \
   --json "$work/r.json" 2>"$work/log" >/dev/null || true
 grep -q '^SEGMENT' "$work/log" || { cat "$work/log" >&2; echo "the run did not reach its stop" >&2; exit 1; }
-sed -n '/^SEGMENT/,$p' "$work/log"
+sed -n '/^SEGMENT/,$p' "$work/log" | grep -v '^=='
 callgrind_annotate --inclusive=yes --tree=calling "$work/cg.out" >"$work/tree.txt" 2>/dev/null
 python3 - "$work/tree.txt" "$steps" "$rev" <<'PY'
 import re, sys
