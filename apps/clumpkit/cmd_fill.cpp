@@ -34,10 +34,15 @@ struct FillArgs {
   bool repair_orientation = false, repair_holes = false;
 };
 
-// A note on stderr when the loader repaired the mesh (--repair-orientation, --repair-holes), and
-// a warning when the holes it closed are a large part of the surface (the shape is then partly
-// invented: a bowl is closed by a lid).
-void note_repairs(const TargetShape& t) {
+// A note on stderr when the loader repaired the mesh (--repair-orientation, --repair-holes), a
+// warning when the holes it closed are a large part of the surface (the shape is then partly
+// invented: a bowl is closed by a lid), and one when the mesh is several separate pieces.
+void note_mesh(const TargetShape& t) {
+  if (t.solids > 1)
+    std::cerr << fmt::format(
+        "clumpkit: warning: {} holds {} separate solids: the clump will be one rigid particle "
+        "made of all of them (fill each piece from its own file for separate particles)\n",
+        t.description, t.solids);
   if (t.reoriented_faces == 0 && t.holes_filled == 0) return;
   std::cerr << fmt::format("clumpkit: note: repaired {}\n", t.description);
   if (t.hole_area_fraction > 0.05)
@@ -64,7 +69,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     load.repair_orientation = a.repair_orientation;
     load.repair_holes = a.repair_holes;
     TargetShape t = target_from_mesh(a.shape, load);
-    note_repairs(t);
+    note_mesh(t);
     warn_if_mesh_units_suspect(a.shape, t.solid->bounds().sizes().maxCoeff(), a.mesh_units);
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
@@ -108,7 +113,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   }
 #ifdef CLUMPKIT_HAVE_RAYCAST
   TargetShape t = target_from_shape(spec);
-  note_repairs(t);
+  note_mesh(t);
   std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
   source["kind"] = "mesh";
   source["mesh"] = spec.mesh.string();

@@ -355,6 +355,26 @@ TEST(FillCli, HoleyMeshIsRefusedOrClosedOnRequest) {
   EXPECT_EQ(run("error " + out.string() + " --rays 20000"), 0) << last_error();
 }
 
+// A mesh of two separate pieces fills as one rigid clump, with a warning saying so.
+TEST(FillCli, SeparatePiecesAreWarnedAbout) {
+  TessellatedMesh t = make_test_shape("cube")->tessellate(0);
+  const std::size_t nv = t.vertices.size(), nt = t.triangles.size();
+  for (std::size_t v = 0; v < nv; ++v)
+    t.vertices.push_back(t.vertices[v] + Eigen::Vector3d(0.01, 0, 0));
+  for (std::size_t f = 0; f < nt; ++f) {
+    const auto& g = t.triangles[f];
+    const int o = static_cast<int>(nv);
+    t.triangles.push_back({g[0] + o, g[1] + o, g[2] + o});
+  }
+  const auto mesh = scratch("two_cubes.stl"), out = scratch("two_cubes.json");
+  std::ofstream(mesh) << to_ascii_stl(t, "two", 1000.0);
+  ASSERT_EQ(
+      run("fill " + mesh.string() + " --mesh-units mm --method edt --spheres 4 -o " + out.string()),
+      0)
+      << last_error();
+  EXPECT_NE(last_error().find("holds 2 separate solids"), std::string::npos) << last_error();
+}
+
 // Real-world meshes from a Debian package (libcgal-demo: CGAL's data archive), read at test time:
 // a scanned elephant and cow and a CAD anchor fill through the mesh path, and the optimiser beats
 // the EDT baseline on each at 12 spheres; a scan with self-intersecting triangles (the bull) is

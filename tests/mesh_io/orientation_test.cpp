@@ -108,6 +108,7 @@ TEST(OrientOutward, NestedBodiesFaceOutwardByTheirNesting) {
     const MeshReport r = validate_mesh(good);
     EXPECT_TRUE(r.closed_solid()) << r.defects();
     EXPECT_EQ(r.bodies, 4u);
+    EXPECT_EQ(r.solids, 2u);  // the hollow ball (with its cavity and island) and the box
     EXPECT_NEAR(r.signed_volume, want, 1e-12 * want);
   }
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
@@ -145,7 +146,14 @@ TEST(BodyOrientation, AWholeMeshInsideOutIsNotMisoriented) {
   const BodyOrientation b = body_orientation(m);
   EXPECT_EQ(b.bodies, 2u);
   EXPECT_EQ(b.misoriented, 0u);
+  EXPECT_EQ(b.solids, 2u);
   EXPECT_EQ(body_orientation(icosphere_mesh(1.0, 1)).bodies, 1u);
+  EXPECT_EQ(body_orientation(icosphere_mesh(1.0, 1)).solids, 1u);
+  // A ball with a cavity is one solid of two bodies.
+  const TriangleMesh hollow =
+      join(icosphere_mesh(2.0, 2), icosphere_mesh(1.0, 2), Eigen::Vector3d::Zero(), true);
+  EXPECT_EQ(body_orientation(hollow).bodies, 2u);
+  EXPECT_EQ(body_orientation(hollow).solids, 1u);
 }
 
 TEST(OrientOutward, OneSidedAndOpenSurfacesAreRefused) {

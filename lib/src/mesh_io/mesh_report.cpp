@@ -110,6 +110,7 @@ MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidateOptions& op
     const BodyOrientation b = body_orientation(mesh);
     r.bodies = b.bodies;
     r.misoriented_bodies = b.misoriented;
+    r.solids = b.solids;
   }
   if (opt.check_self_intersections && topology_ok)
     r.self_intersections = detail::count_self_intersections(mesh);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -113,6 +114,7 @@ std::uint64_t edge_key(int a, int b) {
 BodyOrientation body_orientation(const TriangleMesh& mesh) {
   BodyOrientation r;
   r.bodies = static_cast<std::size_t>(find_bodies(mesh, false).n);
+  r.solids = r.bodies;
   if (r.bodies < 2) return r;
   const Bodies b = find_bodies(mesh);
   // The fewest bodies to turn, the whole mesh's orientation being free (load_mesh flips a mesh
@@ -125,6 +127,7 @@ BodyOrientation body_orientation(const TriangleMesh& mesh) {
     along += v > 0.0;
   }
   r.misoriented = std::min(against, along);
+  r.solids = static_cast<std::size_t>(std::count(depth.begin(), depth.end(), 0));
   return r;
 }
 

@@ -31,6 +31,7 @@ void note_repairs(TargetShape& t, const MeshReport& r) {
   t.reoriented_faces = r.reoriented_faces;
   t.holes_filled = r.holes_filled;
   t.hole_area_fraction = r.area > 0 ? r.hole_area / r.area : 0.0;
+  t.solids = r.solids;
 }
 
 }  // namespace

@@ -22,6 +22,9 @@ struct MeshReport {
   /// Bodies facing against their nesting: an inverted body beside others, or a cavity's wall
   /// facing outward (clumpkit/mesh_io/orientation.hpp). Counted on a closed, consistent manifold.
   std::size_t misoriented_bodies = 0;
+  /// Bodies inside no other body: the separate pieces of the solid (1 for one piece, with or
+  /// without cavities). Counted on a closed, consistent manifold.
+  std::size_t solids = 0;
   std::size_t degenerate_faces = 0;  ///< (near-)zero area; harmless for volume, reported
   /// Pairs of triangles that intersect other than at shared edges/vertices; -1 when not checked
   /// (disabled, or the mesh is not a closed oriented manifold, which CGAL's check requires).

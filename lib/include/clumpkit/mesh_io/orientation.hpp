@@ -17,6 +17,7 @@ namespace clumpkit {
 struct BodyOrientation {
   std::size_t bodies = 0;       ///< vertex-connected components with at least one triangle
   std::size_t misoriented = 0;  ///< fewest bodies to turn so that all face by their nesting
+  std::size_t solids = 0;       ///< bodies inside no other: separate pieces (a cavity is not one)
 };
 
 /// Counts the bodies of a mesh whose every edge is shared by two consistently oriented triangles,

@@ -19,6 +19,7 @@ struct TargetShape {
   std::size_t reoriented_faces = 0;     ///< triangles the orientation repair reversed
   std::size_t holes_filled = 0;         ///< holes the hole repair closed
   double hole_area_fraction = 0.0;      ///< their area over the repaired surface's
+  std::size_t solids = 1;               ///< separate pieces of a mesh (MeshReport::solids)
 };
 
 /// A ShapeSpec as a solid: a cylinder exactly, a mesh through load_shape_mesh.
