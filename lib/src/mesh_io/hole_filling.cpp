@@ -1,9 +1,6 @@
 #include "hole_filling.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
-#include <CGAL/Surface_mesh.h>
 #include <CGAL/exceptions.h>
 #include <fmt/format.h>
 
@@ -11,6 +8,7 @@
 #include <iterator>
 #include <vector>
 
+#include "cgal_surface_mesh.hpp"
 #include "clumpkit/core/error.hpp"
 
 namespace clumpkit::detail {
@@ -19,23 +17,17 @@ namespace {
 
 FilledHoles fill_holes_with_cgal(TriangleMesh& mesh, const std::string& where,
                                  std::size_t max_edges) {
-  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-  using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
+  using K = CgalKernel;
+  using SurfaceMesh = CgalSurfaceMesh;
   namespace PMP = CGAL::Polygon_mesh_processing;
-  std::vector<K::Point_3> points;
-  points.reserve(mesh.vertices.size());
-  for (const Eigen::Vector3d& v : mesh.vertices) points.emplace_back(v[0], v[1], v[2]);
-  std::vector<std::array<std::size_t, 3>> faces;
-  faces.reserve(mesh.triangles.size());
-  for (const Eigen::Vector3i& t : mesh.triangles)
-    faces.push_back({static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]),
-                     static_cast<std::size_t>(t[2])});
-  if (!PMP::is_polygon_soup_a_polygon_mesh(faces))
+  // The caller made the triangles agree and has no edge of more than two: what is left to
+  // refuse is a vertex where surfaces meet without sharing an edge.
+  std::optional<SurfaceMesh> converted = to_surface_mesh(mesh);
+  if (!converted)
     throw InputError(where, "",
                      "cannot fill its holes: surfaces meet at a vertex without sharing an edge "
                      "(a non-manifold vertex)");
-  SurfaceMesh sm;
-  PMP::polygon_soup_to_polygon_mesh(points, faces, sm);
+  SurfaceMesh& sm = *converted;
   // The loops: one border halfedge of each, found by walking every border once.
   std::vector<SurfaceMesh::Halfedge_index> loops;
   std::vector<std::size_t> lengths;

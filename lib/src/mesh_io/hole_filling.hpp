@@ -1,7 +1,7 @@
 #pragma once
 // Hole filling of an open triangle mesh by CGAL (Polygon_mesh_processing::triangulate_hole), kept
 // behind this plain interface so CGAL's headers never reach another translation unit (as
-// self_intersections.hpp).
+// self_intersections.hpp; both convert through cgal_surface_mesh.hpp).
 #include <cstddef>
 #include <string>
 
