@@ -55,6 +55,17 @@ void warn_if_mesh_units_suspect(const std::string& file, double extent, const st
         file, extent * 1e3, units);
 }
 
+void MeshRepairFlags::add_to(CLI::App* command, const std::string& scope) {
+  command->add_flag("--repair-orientation", orientation,
+                    scope +
+                        ": re-orient a closed, manifold mesh whose triangles disagree on "
+                        "orientation (or whose bodies face inward) instead of refusing it");
+  command->add_flag("--repair-holes", holes,
+                    scope +
+                        ": close the holes of an open, manifold mesh (a scan's gaps) with CGAL's "
+                        "hole triangulation, then orient it, instead of refusing it");
+}
+
 void write_json(const nlohmann::json& j, const std::string& target) {
   const std::string text = j.dump(2) + "\n";
   if (target == "-") {

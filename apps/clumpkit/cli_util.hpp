@@ -25,6 +25,28 @@ void write_json(const nlohmann::json& j, const std::string& target);
 /// millimetres, and the default unit is the metre. `extent` is the largest side of its bounds, m.
 void warn_if_mesh_units_suspect(const std::string& file, double extent, const std::string& units);
 
+/// The mesh repairs a command offers (--repair-orientation, --repair-holes): registered once, then
+/// merged into a MeshLoadOptions or a ShapeSpec (both have the two fields; what a shape file asks
+/// for itself stays on).
+struct MeshRepairFlags {
+  bool orientation = false, holes = false;
+  /// Adds the two flags to `command`; `scope` starts their help ("edt/optimal: ...").
+  void add_to(CLI::App* command, const std::string& scope);
+  template <class Options>
+  void apply(Options& o) const {
+    o.repair_orientation = o.repair_orientation || orientation;
+    o.repair_holes = o.repair_holes || holes;
+  }
+};
+
+/// Records the repairs `o` asks for in a clump template's `source`, so that `clumpkit error`
+/// re-reads the mesh the same way.
+template <class Options>
+void record_mesh_repairs(const Options& o, nlohmann::json& source) {
+  if (o.repair_orientation) source["repair_orientation"] = true;
+  if (o.repair_holes) source["repair_holes"] = true;
+}
+
 /// A command registers itself on the app; the returned callback runs it and returns the exit code.
 using Runner = std::function<int()>;
 struct Command {

@@ -28,7 +28,7 @@ struct ErrorArgs {
   std::size_t samples = ShapeErrorOptions{}.surface_samples;
   int replicates = RaySamplingOptions{}.replicates;
   bool table = false;
-  bool repair_orientation = false, repair_holes = false;
+  MeshRepairFlags repairs;  // for --shape; a template's recorded mesh: as it was filled
 };
 
 struct Row {
@@ -75,14 +75,12 @@ Row analyse(const std::string& path, const ErrorArgs& a) {
   } else if (is_mesh_file(a.shape)) {
     MeshLoadOptions load;
     load.scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
-    load.repair_orientation = a.repair_orientation;
-    load.repair_holes = a.repair_holes;
+    a.repairs.apply(load);
     target = target_from_mesh(a.shape, load);
     warn_if_mesh_units_suspect(a.shape, target.solid->bounds().sizes().maxCoeff(), a.mesh_units);
   } else {
     ShapeSpec spec = load_shape(resolve_shape(a.shape));
-    spec.repair_orientation = spec.repair_orientation || a.repair_orientation;
-    spec.repair_holes = spec.repair_holes || a.repair_holes;
+    a.repairs.apply(spec);
     target = target_from_shape(spec);
   }
   ShapeErrorOptions opt;
@@ -263,12 +261,7 @@ Command setup_error(CLI::App& parent) {
                 "test shape of `clumpkit mesh --list`: torus) or "
                 "a closed mesh (.stl .obj .ply .off); default: the template's recorded source");
   c->add_option("--mesh-units", a->mesh_units, "Length unit of a --shape mesh file (m, mm, ...)");
-  c->add_flag("--repair-orientation", a->repair_orientation,
-              "Re-orient a --shape mesh (closed, manifold) whose triangles disagree on "
-              "orientation instead of refusing it (a template's recorded mesh: as it was filled)");
-  c->add_flag("--repair-holes", a->repair_holes,
-              "Close the holes of an open, manifold --shape mesh, then orient it, instead of "
-              "refusing it (a template's recorded mesh: as it was filled)");
+  a->repairs.add_to(c, "with --shape (a template's recorded mesh is read as it was filled)");
   c->add_option("--rays", a->rays, "Rays in total (3 axes x replicates)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{2'000'000'000}));
   c->add_option("--seed", a->seed, "Seed of the ray jitter and surface samples");

@@ -31,7 +31,7 @@ struct FillArgs {
   double max_error = 0.0;
   std::string metric = "symmetric_difference", min_radius, tolerance, mesh_units = "m", density;
   int grid = FillOptions{}.grid;
-  bool repair_orientation = false, repair_holes = false;
+  MeshRepairFlags repairs;
 };
 
 // A note on stderr when the loader repaired the mesh (--repair-orientation, --repair-holes), a
@@ -66,15 +66,13 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     const double scale = unit_factor(a.mesh_units, Dimension::Length, "", "--mesh-units");
     MeshLoadOptions load;
     load.scale = scale;
-    load.repair_orientation = a.repair_orientation;
-    load.repair_holes = a.repair_holes;
+    a.repairs.apply(load);
     TargetShape t = target_from_mesh(a.shape, load);
     note_mesh(t);
     warn_if_mesh_units_suspect(a.shape, t.solid->bounds().sizes().maxCoeff(), a.mesh_units);
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
-    if (a.repair_orientation) source["repair_orientation"] = true;
-    if (a.repair_holes) source["repair_holes"] = true;
+    record_mesh_repairs(load, source);
     return from_surface(solid, a.shape);
   }
 #endif
@@ -94,8 +92,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     return s;
   }
   ShapeSpec spec = load_shape(resolve_shape(a.shape));
-  spec.repair_orientation = spec.repair_orientation || a.repair_orientation;
-  spec.repair_holes = spec.repair_holes || a.repair_holes;
+  a.repairs.apply(spec);
   density = spec.density;
   source = {{"shape", spec.name},
             {"file", spec.path.string()},
@@ -118,8 +115,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   source["kind"] = "mesh";
   source["mesh"] = spec.mesh.string();
   source["mesh_scale"] = spec.mesh_scale;
-  if (spec.repair_orientation) source["repair_orientation"] = true;
-  if (spec.repair_holes) source["repair_holes"] = true;
+  record_mesh_repairs(spec, source);
   return from_surface(solid, spec.path.string());
 #else
   throw InputError(spec.path.string(), "shape.kind", "this build has no mesh support (raycast)");
@@ -200,12 +196,7 @@ Command setup_fill(CLI::App& parent) {
                 "edt/optimal: how far a sphere may leave the shape (\"0.05 mm\"; default 1 % of "
                 "the volume-equivalent diameter)");
   c->add_option("--mesh-units", args->mesh_units, "Length unit of a mesh file (m, mm, ...)");
-  c->add_flag("--repair-orientation", args->repair_orientation,
-              "edt/optimal: re-orient a closed, manifold mesh whose triangles disagree on "
-              "orientation (or whose bodies face inward) instead of refusing it");
-  c->add_flag("--repair-holes", args->repair_holes,
-              "edt/optimal: close the holes of an open, manifold mesh (a scan's gaps) with CGAL's "
-              "hole triangulation, then orient it, instead of refusing it");
+  args->repairs.add_to(c, "edt/optimal");
   c->add_option("--density", args->density,
                 "edt/optimal: density (\"1380 kg/m^3\"; default the shape file's, else 1380)");
   c->add_option("--grid", args->grid, "edt/optimal: distance-grid cells along the longest side")
