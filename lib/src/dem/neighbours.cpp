@@ -126,12 +126,12 @@ void World::Impl::rebuild_neighbours() {
   // Pairs found, per thread, as (smaller, larger) sphere index; gathered below into the list
   // sorted by (i, j), which does not depend on which thread found what.
   const int nt = std::max(1, threads);
-  std::vector<std::vector<std::array<int, 2>>>& found = scratch_found;
+  std::vector<PerThread<std::array<int, 2>>>& found = scratch_found;
   found.resize(nt);
-  for (auto& f : found) f.clear();
+  for (auto& f : found) f.v.clear();
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (ns >= kParallelMin)
   for (int r = 0; r < nruns; ++r) {
-    auto& out = found[omp_get_thread_num()];
+    auto& out = found[omp_get_thread_num()].v;
     const std::array<std::int64_t, 3>& c = sc[bins[runs[r]].second];
     const std::uint64_t above = cell_key(c[0], c[1], c[2] + 1);
     int own_hi = runs[r + 1];
@@ -162,8 +162,8 @@ void World::Impl::rebuild_neighbours() {
   start.assign(ns + 1, 0);
   size_t npairs = 0;
   for (const auto& f : found) {
-    npairs += f.size();
-    for (const auto& p : f) ++start[p[0] + 1];
+    npairs += f.v.size();
+    for (const auto& p : f.v) ++start[p[0] + 1];
   }
   for (int i = 0; i < ns; ++i) start[i + 1] += start[i];
   std::vector<PairEntry> next(npairs);
@@ -171,7 +171,7 @@ void World::Impl::rebuild_neighbours() {
     std::vector<int>& fill = scratch_fill;
     fill.assign(start.begin(), start.end() - 1);
     for (const auto& f : found)
-      for (const auto& p : f) next[fill[p[0]]++] = {p[0], p[1]};
+      for (const auto& p : f.v) next[fill[p[0]]++] = {p[0], p[1]};
   }
 #pragma omp parallel for num_threads(threads) schedule(static) if (ns >= kParallelMin)
   for (int i = 0; i < ns; ++i)

@@ -311,7 +311,7 @@ void World::Impl::detect_contacts() {
     const int t = omp_get_thread_num();
     const int k0 = static_cast<int>(std::int64_t(np) * t / nt);
     const int k1 = static_cast<int>(std::int64_t(np) * (t + 1) / nt);
-    std::vector<std::pair<int, double>>& touch = scratch_touch[t];
+    std::vector<std::pair<int, double>>& touch = scratch_touch[t].v;
     touch.clear();
     for (int k = k0; k < k1; ++k) {
       const PairEntry& p = pairs[k];
@@ -366,6 +366,7 @@ void World::Impl::detect_contacts() {
     scratch_max[t] = {best, best_k};
   }
   pair_contacts.resize(offset[nt]);
+  contact_block_start.assign(offset.begin(), offset.end());
   max_overlap_ratio = 0.0;
   for (int t = 0; t < nt; ++t)
     if (scratch_max[t].first > max_overlap_ratio) {
@@ -387,7 +388,9 @@ void World::Impl::detect_contacts() {
   std::vector<int>& overflow = scratch_overflow;
   ratio_s.assign(na, 0.0);
   overflow.assign(na, 0);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) if (na >= 64)
+  // Statically shared out, as the wall laws are (compute_forces): each sphere's wall contacts
+  // stay with one thread from step to step.
+#pragma omp parallel for num_threads(threads) schedule(static) if (na >= 64)
   for (int a = 0; a < na; ++a) {
     const int s = wall_active[a];
     struct Cand {
@@ -550,7 +553,7 @@ void World::Impl::compute_forces(double hdt) {
   std::vector<int>& i_start = scratch_i_start;
   std::vector<int>& j_start = scratch_j_start;
   std::vector<int>& j_list = scratch_j_list;
-  // The pair laws go out in blocks of the list (dynamically: the cost per contact varies).
+  // The pair laws go out in blocks of the list; their energies are summed per block.
   constexpr int kBlock = 256;
   const int nblocks = (npc + kBlock - 1) / kBlock;
   std::vector<double>& block_energy = scratch_block_energy;
@@ -562,17 +565,23 @@ void World::Impl::compute_forces(double hdt) {
   j_count.resize(nt_all);
   auto clump_i = [&](int k) { return pair_contact_clumps[k][0]; };
   auto clump_j = [&](int k) { return pair_contact_clumps[k][1]; };
+  // The same thread that wrote a block of the contact list in detect_contacts (its geometry
+  // and the pairs' histories are in that core's cache) indexes it and evaluates its laws.
+  const std::vector<int>& cbs = contact_block_start;
+  const bool aligned = static_cast<int>(cbs.size()) == nt_all + 1 && cbs[nt_all] == npc;
   // One parallel region: clump kinematics and the contact index, the pair and wall laws, then
-  // the sums. The laws and the sums are shared out dynamically (the cost per contact and per
-  // clump varies along the lists: jammed clumps at the bottom of a bed need the implicit
-  // solve); every clump's sum is done by one thread, visiting its contacts in list order
-  // (pairs by (i, j), then its spheres' wall contacts by sphere), so it is the same sequence
-  // of additions for any thread count.
+  // the sums. Work goes to the threads statically, in contiguous ranges that stay with a
+  // thread from stage to stage and step to step: shared out dynamically, most of what a stage
+  // reads had last been written by the other core, and two threads were measured no faster
+  // than one on the paper angle of repose (docs/dem.md). Every clump's sum is done by one
+  // thread, visiting its contacts in list order (pairs by (i, j), then its spheres' wall
+  // contacts by sphere), so it is the same sequence of additions for any thread count and
+  // any division of the work.
 #pragma omp parallel num_threads(nt_all) if (parallel) reduction(+ : n_implicit)
   {
     const int nt = omp_get_num_threads(), t = omp_get_thread_num();
-    const int k0 = static_cast<int>(std::int64_t(npc) * t / nt);
-    const int k1 = static_cast<int>(std::int64_t(npc) * (t + 1) / nt);
+    const int k0 = aligned ? cbs[t] : static_cast<int>(std::int64_t(npc) * t / nt);
+    const int k1 = aligned ? cbs[t + 1] : static_cast<int>(std::int64_t(npc) * (t + 1) / nt);
 #pragma omp for schedule(static) nowait
     for (int c = 0; c < nc; ++c) {
       c_ww[c] = c_R[c] * c_wb[c];
@@ -608,8 +617,9 @@ void World::Impl::compute_forces(double hdt) {
     }
     for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;
 
-#pragma omp for schedule(dynamic, 1) nowait
-    for (int b = 0; b < nblocks; ++b) {
+    // Block b goes to the thread whose range holds its first contact.
+    const int b0 = (k0 + kBlock - 1) / kBlock, b1 = (k1 + kBlock - 1) / kBlock;
+    for (int b = b0; b < b1; ++b) {
       double block_elastic = 0.0;
       for (int k = b * kBlock; k < std::min(npc, (b + 1) * kBlock); ++k) {
         PairContactData& pc = pair_contacts[k];
@@ -642,7 +652,8 @@ void World::Impl::compute_forces(double hdt) {
       block_energy[b] = block_elastic;
     }
 
-#pragma omp for schedule(dynamic, 64)
+    // The wall laws, in the ranges of wall_active detect_contacts gave each thread.
+#pragma omp for schedule(static)
     for (int a = 0; a < na; ++a) {
       const int s = wall_active[a];
       const int n = wall_contact_n[s];
@@ -676,9 +687,29 @@ void World::Impl::compute_forces(double hdt) {
     }
 
     // Sums (the loop above ends in a barrier, so every contact's force and the index are in
-    // place), then the implicit damping of each clump that needs it.
-#pragma omp for schedule(dynamic, 16)
-    for (int c = 0; c < nc; ++c) {
+    // place), then the implicit damping of each clump that needs it. Contiguous ranges of
+    // clumps of about equal work, counted as one per clump and two per pair contact held as
+    // sphere i (each contact is summed on both of its sides, and over a range of clumps the j
+    // sides are about as many as the i sides): where clumps were poured in order, the first
+    // ones lie deepest in the bed, with the most contacts.
+    auto work = [&](int c) { return std::int64_t(c) + 2 * std::int64_t(i_start[c]); };
+    const std::int64_t w_all = work(nc);
+    auto first_clump = [&](int u) {
+      if (u == 0) return 0;
+      if (u == nt) return nc;
+      const std::int64_t target = w_all * u / nt;
+      int lo = 0, hi = nc;  // the first clump whose work before it reaches the target
+      while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (work(mid) < target)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+      return lo;
+    };
+    const int c_lo = first_clump(t), c_hi = first_clump(t + 1);
+    for (int c = c_lo; c < c_hi; ++c) {
       Eigen::Vector3d f = Eigen::Vector3d::Zero(), tq = Eigen::Vector3d::Zero();
       double mroll = 0.0;
       Eigen::Vector2d load = Eigen::Vector2d::Zero();

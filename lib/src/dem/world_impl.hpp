@@ -208,13 +208,22 @@ struct World::Impl {
   double max_overlap_ratio = 0.0;
   std::string max_overlap_what;
   bool slot_overflow_warned = false;
+  // A thread's own scratch vector, on cache lines of its own: side by side in one array, the
+  // threads' vectors would share a line whose end pointers each push_back writes.
+  template <class T>
+  struct alignas(64) PerThread {
+    std::vector<T> v;
+  };
   // Per-step scratch of detect_contacts (kept to avoid reallocation).
   std::vector<double> scratch_ratio;
-  std::vector<std::vector<std::array<int, 2>>> scratch_found;      // per thread, rebuild_neighbours
-  std::vector<int> scratch_start, scratch_fill;                    // rebuild_neighbours
-  std::vector<std::vector<std::array<int, 2>>> scratch_cand;       // per sphere, rebuild_neighbours
-  std::vector<std::pair<std::uint64_t, int>> scratch_bins;         // rebuild_neighbours
-  std::vector<std::vector<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
+  std::vector<PerThread<std::array<int, 2>>> scratch_found;      // per thread, rebuild_neighbours
+  std::vector<int> scratch_start, scratch_fill;                  // rebuild_neighbours
+  std::vector<std::vector<std::array<int, 2>>> scratch_cand;     // per sphere, rebuild_neighbours
+  std::vector<std::pair<std::uint64_t, int>> scratch_bins;       // rebuild_neighbours
+  std::vector<PerThread<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
+  // Where each thread's block of pair_contacts starts (threads + 1 entries, the last the
+  // count), as detect_contacts wrote them: the laws are evaluated by the same thread.
+  std::vector<int> contact_block_start;
   std::vector<std::pair<double, int>> scratch_max;  // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
   // Per-step scratch of compute_forces: each clump's pair contacts (as sphere i: a range of
