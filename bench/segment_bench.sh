@@ -16,7 +16,8 @@
 # times and the state hash, time each stage 300 more times on that state (minimum, quartile,
 # median per call) and exit. Same STEPS from the same checkpoint give the same hash for any
 # commit that keeps the engine's bits. THREADS (default 1) sets --threads; SIDE_BY_SIDE=0
-# runs the commits one after another.
+# runs the commits one after another; THREAD_TIMERS=1 adds bench/thread_timers.py's per-thread
+# times of the contacts' and forces' parts (a little slower: each timer is a clock read).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/.." && pwd)
@@ -38,6 +39,7 @@ bins=()
 for k in "${!revs[@]}"; do
   git -C "$repo" worktree add -q --detach "$work/src$k" "${revs[$k]}"
   python3 "$here/segment_stop.py" "$work/src$k/lib/src/dem/step.cpp"
+  if [ "${THREAD_TIMERS:-0}" = 1 ]; then python3 "$here/thread_timers.py" "$work/src$k/lib/src/dem/step.cpp"; fi
   cmake -S "$work/src$k" -B "$work/build$k" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_UNITY_BUILD=ON >/dev/null
   cmake --build "$work/build$k" -j2 --target clumpkit >/dev/null
