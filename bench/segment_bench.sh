@@ -15,7 +15,8 @@
 # with one addition, bench/segment_stop.py, and run by bench/resume_bench.sh: after STEPS steps of a World, print the stage
 # times and the state hash, time each stage 300 more times on that state (minimum, quartile,
 # median per call) and exit. Same STEPS from the same checkpoint give the same hash for any
-# commit that keeps the engine's bits. THREADS (default 1) sets --threads; SIDE_BY_SIDE=0
+# commit that keeps the engine's bits. THREADS (default 1) sets --threads, or several in turn
+# ("1 2": each round runs every commit on one thread, then on two); SIDE_BY_SIDE=0
 # runs the commits one after another; THREAD_TIMERS=1 adds bench/thread_timers.py's per-thread
 # times of the contacts' and forces' parts (a little slower: each timer is a clock read).
 set -euo pipefail
@@ -51,5 +52,8 @@ done
 # The runs themselves are bench/resume_bench.sh's, with the stop switched on.
 export CLUMPKIT_SEGMENT_STEPS=$steps SIDE_BY_SIDE=${SIDE_BY_SIDE:-1}
 for r in $(seq "$rounds"); do
-  "$here/resume_bench.sh" "$snap" "${THREADS:-1}" "${bins[@]}" -- "$@"
+  for th in ${THREADS:-1}; do
+    echo "round $r, --threads $th"
+    "$here/resume_bench.sh" "$snap" "$th" "${bins[@]}" -- "$@"
+  done
 done
