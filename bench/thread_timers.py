@@ -7,7 +7,8 @@ end a part included; the segment stop prints the sums per thread after its SEGME
 
   pair scan      the listed pairs' distance test (detect_contacts)
   pair geometry  writing the touching pairs' contact geometry (detect_contacts)
-  index          the per-clump contact index (compute_forces, up to and with its barrier)
+  kinematics     each clump's angular velocity and predicted velocity (compute_forces)
+  index          the per-clump contact index, in four parts with its barrier and single
   pair laws      the pair contacts' laws
   wall laws      the wall contacts' laws, with the barrier that ends them
   sums           each clump's force and torque, and its implicit damping
@@ -28,7 +29,7 @@ def rep(old, new):
     src = src.replace(old, new)
 
 
-PARTS = ["index (clumps)", "index (count)", "index (barrier)", "index (single)", "index (list)",
+PARTS = ["kinematics", "index (count)", "index (barrier)", "index (single)", "index (list)",
          "pair laws", "wall laws", "sums", "", "", "pair scan", "pair scan (barrier)",
          "pair geometry"]
 rep("namespace clumpkit::dem {\n",
@@ -61,9 +62,9 @@ rep("    const int t = omp_get_thread_num();\n"
     "    const int k0 = static_cast<int>(std::int64_t(np) * t / nt);",
     "    const int t = omp_get_thread_num();\n    double last_ = omp_get_wtime();\n"
     "    const int k0 = static_cast<int>(std::int64_t(np) * t / nt);")
-rep("    offset[t + 1] = touch.size();\n#pragma omp barrier",
-    "    offset[t + 1] = touch.size();\n    THREAD_TIMER(10);\n#pragma omp barrier\n"
-    "    THREAD_TIMER(11);")
+rep("#pragma omp barrier\n#pragma omp single\n    {\n      for (int u = 0; u < nt; ++u) offset",
+    "    THREAD_TIMER(10);\n#pragma omp barrier\n    THREAD_TIMER(11);\n#pragma omp single\n"
+    "    {\n      for (int u = 0; u < nt; ++u) offset")
 rep("    scratch_max[t] = {best, best_k};\n  }",
     "    scratch_max[t] = {best, best_k};\n    THREAD_TIMER(12);\n  }")
 # The report, after the segment stop's SEGMENT lines.

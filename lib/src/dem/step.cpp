@@ -305,7 +305,10 @@ void World::Impl::detect_contacts() {
   }
   scratch_touch.resize(nt);
   scratch_max.assign(nt, {0.0, -1});
-  std::vector<size_t> offset(nt + 1, 0);
+  // Each thread's block of the contact list starts at offset[t]; compute_forces gives the
+  // block's laws to the same thread.
+  std::vector<int>& offset = contact_block_start;
+  offset.assign(nt + 1, 0);
 #pragma omp parallel num_threads(nt) if (nt > 1)
   {
     const int t = omp_get_thread_num();
@@ -336,12 +339,12 @@ void World::Impl::detect_contacts() {
         }
       }
     }
-    offset[t + 1] = touch.size();
+    offset[t + 1] = static_cast<int>(touch.size());
 #pragma omp barrier
 #pragma omp single
     {
       for (int u = 0; u < nt; ++u) offset[u + 1] += offset[u];
-      if (pair_contacts.size() < offset[nt]) pair_contacts.resize(offset[nt]);
+      if (static_cast<int>(pair_contacts.size()) < offset[nt]) pair_contacts.resize(offset[nt]);
       pair_contact_clumps.resize(offset[nt]);
     }
     double best = 0.0;
@@ -366,7 +369,6 @@ void World::Impl::detect_contacts() {
     scratch_max[t] = {best, best_k};
   }
   pair_contacts.resize(offset[nt]);
-  contact_block_start.assign(offset.begin(), offset.end());
   max_overlap_ratio = 0.0;
   for (int t = 0; t < nt; ++t)
     if (scratch_max[t].first > max_overlap_ratio) {

@@ -222,7 +222,7 @@ struct World::Impl {
   std::vector<std::pair<std::uint64_t, int>> scratch_bins;       // rebuild_neighbours
   std::vector<PerThread<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
   // Where each thread's block of pair_contacts starts (threads + 1 entries, the last the
-  // count), as detect_contacts wrote them: the laws are evaluated by the same thread.
+  // count), as detect_contacts wrote them; compute_forces evaluates them on the same threads.
   std::vector<int> contact_block_start;
   std::vector<std::pair<double, int>> scratch_max;  // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
