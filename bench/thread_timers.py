@@ -9,8 +9,8 @@ end a part included; the segment stop prints the sums per thread after its SEGME
   pair geometry  writing the touching pairs' contact geometry (detect_contacts)
   kinematics     each clump's angular velocity and predicted velocity (compute_forces)
   index          the per-clump contact index, in four parts with its barrier and single
-  pair laws      the pair contacts' laws
-  wall laws      the wall contacts' laws, with the barrier that ends them
+  pair laws      the pair contacts' laws (its own blocks, then what is left of the other's)
+  wall laws      the wall contacts' laws, with the barrier that ends them (likewise)
   sums           each clump's force and torque, and its implicit damping
 
 What it shows: whether two threads each do their half of a part in half the time one thread
@@ -50,12 +50,12 @@ rep("#pragma omp barrier\n#pragma omp single\n    {\n      int at = 0;",
 rep("    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n",
     "    THREAD_TIMER(3);\n    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n"
     "    THREAD_TIMER(4);\n")
-rep("      block_energy[b] = block_elastic;\n    }\n",
-    "      block_energy[b] = block_elastic;\n    }\n    THREAD_TIMER(5);\n")
-rep("    // Sums (the loop above ends in a barrier",
-    "    THREAD_TIMER(6);\n    // Sums (the loop above ends in a barrier")
-rep("        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }",
-    "        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }\n"
+rep("      block_energy[b] = block_elastic;\n    });\n",
+    "      block_energy[b] = block_elastic;\n    });\n    THREAD_TIMER(5);\n")
+rep("#pragma omp barrier\n    sum_cursors.run(",
+    "#pragma omp barrier\n    THREAD_TIMER(6);\n    sum_cursors.run(")
+rep("          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });",
+    "          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });\n"
     "    THREAD_TIMER(7);")
 # detect_contacts
 rep("    const int t = omp_get_thread_num();\n"
