@@ -29,6 +29,14 @@ def rep(old, new):
     src = src.replace(old, new)
 
 
+def rep_either(pairs):
+    """The first (old, new) whose anchor is there: the code before and after 3cd9451."""
+    for old, new in pairs:
+        if src.count(old) == 1:
+            return rep(old, new)
+    rep(pairs[0][0], pairs[0][1])  # stops, naming the first
+
+
 PARTS = ["kinematics", "index (count)", "index (barrier)", "index (single)", "index (list)",
          "pair laws", "wall laws", "sums", "", "", "pair scan", "pair scan (barrier)",
          "pair geometry"]
@@ -50,13 +58,21 @@ rep("#pragma omp barrier\n#pragma omp single\n    {\n      int at = 0;",
 rep("    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n",
     "    THREAD_TIMER(3);\n    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n"
     "    THREAD_TIMER(4);\n")
-rep("      block_energy[b] = block_elastic;\n    });\n",
-    "      block_energy[b] = block_elastic;\n    });\n    THREAD_TIMER(5);\n")
-rep("#pragma omp barrier\n    sum_cursors.run(",
-    "#pragma omp barrier\n    THREAD_TIMER(6);\n    sum_cursors.run(")
-rep("          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });",
-    "          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });\n"
-    "    THREAD_TIMER(7);")
+# Since 3cd9451 the laws and sums are lambdas run by RangeCursors; before, plain loops.
+rep_either([("      block_energy[b] = block_elastic;\n    });\n",
+             "      block_energy[b] = block_elastic;\n    });\n    THREAD_TIMER(5);\n"),
+            ("      block_energy[b] = block_elastic;\n    }\n",
+             "      block_energy[b] = block_elastic;\n    }\n    THREAD_TIMER(5);\n")])
+rep_either([("#pragma omp barrier\n    sum_cursors.run(",
+             "#pragma omp barrier\n    THREAD_TIMER(6);\n    sum_cursors.run("),
+            ("    // Sums (the loop above ends in a barrier",
+             "    THREAD_TIMER(6);\n    // Sums (the loop above ends in a barrier")])
+rep_either([("          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });",
+             "          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n"
+             "    });\n    THREAD_TIMER(7);"),
+            ("        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }",
+             "        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }\n"
+             "    THREAD_TIMER(7);")])
 # detect_contacts
 rep("    const int t = omp_get_thread_num();\n"
     "    const int k0 = static_cast<int>(std::int64_t(np) * t / nt);",
