@@ -30,7 +30,8 @@ def rep(old, new):
 
 
 def rep_either(pairs):
-    """The first (old, new) whose anchor is there: the code before and after 3cd9451."""
+    """The first (old, new) whose anchor is there: the code as it is, or with
+    bench/tried/range_cursors.diff applied."""
     for old, new in pairs:
         if src.count(old) == 1:
             return rep(old, new)
@@ -58,7 +59,7 @@ rep("#pragma omp barrier\n#pragma omp single\n    {\n      int at = 0;",
 rep("    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n",
     "    THREAD_TIMER(3);\n    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n"
     "    THREAD_TIMER(4);\n")
-# Since 3cd9451 the laws and sums are lambdas run by RangeCursors; before, plain loops.
+# With bench/tried/range_cursors.diff the laws and sums are lambdas run by RangeCursors.
 rep_either([("      block_energy[b] = block_elastic;\n    });\n",
              "      block_energy[b] = block_elastic;\n    });\n    THREAD_TIMER(5);\n"),
             ("      block_energy[b] = block_elastic;\n    }\n",

@@ -17,11 +17,6 @@ namespace clumpkit::dem {
 
 namespace {
 
-// Pieces in which the wall spheres and the clumps' sums are claimed (range_cursors.hpp): a few
-// microseconds of work each.
-constexpr int kWallChunk = 32;
-constexpr int kSumChunk = 32;
-
 double seconds_since(Clock::time_point& t0) {
   const auto t1 = Clock::now();
   const double s = std::chrono::duration<double>(t1 - t0).count();
@@ -395,122 +390,118 @@ void World::Impl::detect_contacts() {
   std::vector<int>& overflow = scratch_overflow;
   ratio_s.assign(na, 0.0);
   overflow.assign(na, 0);
-  // In the same ranges per thread as the wall laws (compute_forces): each sphere's wall
-  // contacts stay with one thread from step to step, unless another thread is free first.
-  const int nt_w = na >= 64 ? std::max(threads, 1) : 1;
-  wall_cursors.split_evenly(na, nt_w);
-#pragma omp parallel num_threads(nt_w) if (nt_w > 1)
-  wall_cursors.run(omp_get_thread_num(), kWallChunk, [&](int a0, int a1) {
-    for (int a = a0; a < a1; ++a) {
-      const int s = wall_active[a];
-      struct Cand {
-        double dist;
-        int wall, tri;
-        Eigen::Vector3d point;
-      };
-      Cand cands[32];
-      int nc = 0;
-      const Eigen::Vector3d& p = s_pos[s];
-      const double r = s_r[s];
-      for (int k = wall_cand_start[s]; k < wall_cand_start[s + 1] && nc < 32; ++k) {
-        const auto [wi, ti] = wall_cand[k];
-        const WallData& wd = walls[wi];
-        // Most candidates (within the skin, not touching) stop at this one dot product.
-        if (beyond_plane(wd, ti, p, r)) continue;
-        const auto& tri = wd.triangles[ti];
-        const Eigen::Vector3d c = closest_point_on_triangle(
-            p, wd.vertices[tri[0]], wd.vertices[tri[1]], wd.vertices[tri[2]]);
-        const double d = (p - c).norm();
-        if (d < r) cands[nc++] = {d, wi, ti, c};
-      }
-      // The usual case: nothing touching and no contact held. A slot not held (wall −1) is all
-      // zero (it is only ever written as such), so there is nothing to carry over or clear.
-      if (nc == 0 && wall_held[s] == 0) {
-        wall_contact_n[s] = 0;
-        continue;
-      }
-      std::sort(cands, cands + nc, [](const Cand& x, const Cand& y) {
-        if (x.dist != y.dist) return x.dist < y.dist;
-        if (x.wall != y.wall) return x.wall < y.wall;
-        return x.tri < y.tri;
-      });
-      auto& out = wall_contacts[a];
-      int n = 0;
-      for (int k = 0; k < nc; ++k) {
-        const Cand& cd = cands[k];
-        Eigen::Vector3d normal;
-        if (cd.dist > 0.0) {
-          normal = (p - cd.point) / cd.dist;
-        } else {  // centre exactly on the triangle: use the face normal
-          const WallData& wd = walls[cd.wall];
-          const auto& tri = wd.triangles[cd.tri];
-          normal = (wd.vertices[tri[1]] - wd.vertices[tri[0]])
-                       .cross(wd.vertices[tri[2]] - wd.vertices[tri[0]])
-                       .normalized();
-        }
-        bool same = false;
-        for (int j = 0; j < n && !same; ++j)
-          same = (cd.point - out[j].point).dot(out[j].normal) <= 1e-9 * r ||
-                 normal.dot(out[j].normal) >= merge_cos;
-        if (same) continue;
-        if (n == kWallSlots) {
-          overflow[a] = 1;
-          break;
-        }
-        WallContactData& wc = out[n++];
-        wc.wall = cd.wall;
-        wc.normal = normal;
-        wc.point = cd.point;
-        wc.overlap = r - cd.dist;
-        ratio_s[a] = std::max(ratio_s[a], wc.overlap / r);
-      }
-      // Carry the history springs over: same wall, closest normal.
-      auto& slots = wall_slots[s];
-      if (n == 1 && wall_held[s] == 1 && slots[0].wall == out[0].wall &&
-          slots[0].normal.dot(out[0].normal) > 0.5) {
-        // The usual case, one contact that goes on: what the general case below gives, in place.
-        slots[0].normal = out[0].normal;
-        out[0].closing = false;
-        wall_contact_n[s] = 1;
-        continue;
-      }
-      std::array<WallSlot, kWallSlots> next{};
-      std::array<bool, kWallSlots> used{};
-      for (int k = 0; k < n; ++k) {
-        int best = -1;
-        double best_dot = 0.5;
-        for (int j = 0; j < kWallSlots; ++j)
-          if (!used[j] && slots[j].wall == out[k].wall) {
-            const double dd = slots[j].normal.dot(out[k].normal);
-            if (dd > best_dot) best_dot = dd, best = j;
-          }
-        next[k].wall = out[k].wall;
-        next[k].normal = out[k].normal;
-        if (best >= 0) {
-          used[best] = true;
-          next[k].history = slots[best].history;
-        }
-        out[k].closing = false;
-      }
-      // Contacts that ended during the step and still owe their last damping impulse.
-      for (int j = 0; j < kWallSlots && n < kWallSlots; ++j)
-        if (!used[j] && slots[j].wall >= 0 && slots[j].history.damping != 0.0) {
-          WallContactData& wc = out[n];
-          wc.wall = slots[j].wall;
-          wc.normal = slots[j].normal;
-          wc.point = p - r * slots[j].normal;
-          wc.overlap = 0.0;
-          wc.closing = true;
-          next[n].wall = slots[j].wall;
-          next[n].normal = slots[j].normal;
-          next[n].history = slots[j].history;
-          ++n;
-        }
-      slots = next;
-      wall_held[s] = static_cast<std::uint8_t>((1u << n) - 1u);  // next holds slots 0 … n − 1
-      wall_contact_n[s] = n;
+  // Statically shared out, as the wall laws are (compute_forces): each sphere's wall contacts
+  // stay with one thread from step to step.
+#pragma omp parallel for num_threads(threads) schedule(static) if (na >= 64)
+  for (int a = 0; a < na; ++a) {
+    const int s = wall_active[a];
+    struct Cand {
+      double dist;
+      int wall, tri;
+      Eigen::Vector3d point;
+    };
+    Cand cands[32];
+    int nc = 0;
+    const Eigen::Vector3d& p = s_pos[s];
+    const double r = s_r[s];
+    for (int k = wall_cand_start[s]; k < wall_cand_start[s + 1] && nc < 32; ++k) {
+      const auto [wi, ti] = wall_cand[k];
+      const WallData& wd = walls[wi];
+      // Most candidates (within the skin, not touching) stop at this one dot product.
+      if (beyond_plane(wd, ti, p, r)) continue;
+      const auto& tri = wd.triangles[ti];
+      const Eigen::Vector3d c = closest_point_on_triangle(p, wd.vertices[tri[0]],
+                                                          wd.vertices[tri[1]], wd.vertices[tri[2]]);
+      const double d = (p - c).norm();
+      if (d < r) cands[nc++] = {d, wi, ti, c};
     }
-  });
+    // The usual case: nothing touching and no contact held. A slot not held (wall −1) is all
+    // zero (it is only ever written as such), so there is nothing to carry over or clear.
+    if (nc == 0 && wall_held[s] == 0) {
+      wall_contact_n[s] = 0;
+      continue;
+    }
+    std::sort(cands, cands + nc, [](const Cand& x, const Cand& y) {
+      if (x.dist != y.dist) return x.dist < y.dist;
+      if (x.wall != y.wall) return x.wall < y.wall;
+      return x.tri < y.tri;
+    });
+    auto& out = wall_contacts[a];
+    int n = 0;
+    for (int k = 0; k < nc; ++k) {
+      const Cand& cd = cands[k];
+      Eigen::Vector3d normal;
+      if (cd.dist > 0.0) {
+        normal = (p - cd.point) / cd.dist;
+      } else {  // centre exactly on the triangle: use the face normal
+        const WallData& wd = walls[cd.wall];
+        const auto& tri = wd.triangles[cd.tri];
+        normal = (wd.vertices[tri[1]] - wd.vertices[tri[0]])
+                     .cross(wd.vertices[tri[2]] - wd.vertices[tri[0]])
+                     .normalized();
+      }
+      bool same = false;
+      for (int j = 0; j < n && !same; ++j)
+        same = (cd.point - out[j].point).dot(out[j].normal) <= 1e-9 * r ||
+               normal.dot(out[j].normal) >= merge_cos;
+      if (same) continue;
+      if (n == kWallSlots) {
+        overflow[a] = 1;
+        break;
+      }
+      WallContactData& wc = out[n++];
+      wc.wall = cd.wall;
+      wc.normal = normal;
+      wc.point = cd.point;
+      wc.overlap = r - cd.dist;
+      ratio_s[a] = std::max(ratio_s[a], wc.overlap / r);
+    }
+    // Carry the history springs over: same wall, closest normal.
+    auto& slots = wall_slots[s];
+    if (n == 1 && wall_held[s] == 1 && slots[0].wall == out[0].wall &&
+        slots[0].normal.dot(out[0].normal) > 0.5) {
+      // The usual case, one contact that goes on: what the general case below gives, in place.
+      slots[0].normal = out[0].normal;
+      out[0].closing = false;
+      wall_contact_n[s] = 1;
+      continue;
+    }
+    std::array<WallSlot, kWallSlots> next{};
+    std::array<bool, kWallSlots> used{};
+    for (int k = 0; k < n; ++k) {
+      int best = -1;
+      double best_dot = 0.5;
+      for (int j = 0; j < kWallSlots; ++j)
+        if (!used[j] && slots[j].wall == out[k].wall) {
+          const double dd = slots[j].normal.dot(out[k].normal);
+          if (dd > best_dot) best_dot = dd, best = j;
+        }
+      next[k].wall = out[k].wall;
+      next[k].normal = out[k].normal;
+      if (best >= 0) {
+        used[best] = true;
+        next[k].history = slots[best].history;
+      }
+      out[k].closing = false;
+    }
+    // Contacts that ended during the step and still owe their last damping impulse.
+    for (int j = 0; j < kWallSlots && n < kWallSlots; ++j)
+      if (!used[j] && slots[j].wall >= 0 && slots[j].history.damping != 0.0) {
+        WallContactData& wc = out[n];
+        wc.wall = slots[j].wall;
+        wc.normal = slots[j].normal;
+        wc.point = p - r * slots[j].normal;
+        wc.overlap = 0.0;
+        wc.closing = true;
+        next[n].wall = slots[j].wall;
+        next[n].normal = slots[j].normal;
+        next[n].history = slots[j].history;
+        ++n;
+      }
+    slots = next;
+    wall_held[s] = static_cast<std::uint8_t>((1u << n) - 1u);  // next holds slots 0 … n − 1
+    wall_contact_n[s] = n;
+  }
   for (int a = 0; a < na; ++a) {
     const int s = wall_active[a];
     if (ratio_s[a] > max_overlap_ratio) {
@@ -581,20 +572,18 @@ void World::Impl::compute_forces(double hdt) {
   const std::vector<int>& cbs = contact_block_start;
   const bool aligned = static_cast<int>(cbs.size()) == nt_all + 1 && cbs[nt_all] == npc;
   // One parallel region: clump kinematics and the contact index, the pair and wall laws, then
-  // the sums. Work goes to the threads in contiguous ranges that stay with a thread from stage
-  // to stage and step to step: shared out dynamically, most of what a stage reads had last been
-  // written by the other core, and two threads were measured no faster than one on the paper
-  // angle of repose (docs/dem.md). A thread that finishes its range takes what is left of the
-  // others' (range_cursors.hpp). Every clump's sum is done by one thread, visiting its contacts
-  // in list order (pairs by (i, j), then its spheres' wall contacts by sphere), so it is the
-  // same sequence of additions for any thread count and any division of the work.
+  // the sums. Work goes to the threads statically, in contiguous ranges that stay with a
+  // thread from stage to stage and step to step: shared out dynamically, most of what a stage
+  // reads had last been written by the other core, and two threads were measured no faster
+  // than one on the paper angle of repose (docs/dem.md). Every clump's sum is done by one
+  // thread, visiting its contacts in list order (pairs by (i, j), then its spheres' wall
+  // contacts by sphere), so it is the same sequence of additions for any thread count and
+  // any division of the work.
 #pragma omp parallel num_threads(nt_all) if (parallel) reduction(+ : n_implicit)
   {
     const int nt = omp_get_num_threads(), t = omp_get_thread_num();
-    auto contact_start = [&](int u) {
-      return aligned ? cbs[u] : static_cast<int>(std::int64_t(npc) * u / nt);
-    };
-    const int k0 = contact_start(t), k1 = contact_start(t + 1);
+    const int k0 = aligned ? cbs[t] : static_cast<int>(std::int64_t(npc) * t / nt);
+    const int k1 = aligned ? cbs[t + 1] : static_cast<int>(std::int64_t(npc) * (t + 1) / nt);
 #pragma omp for schedule(static) nowait
     for (int c = 0; c < nc; ++c) {
       c_ww[c] = c_R[c] * c_wb[c];
@@ -627,39 +616,12 @@ void World::Impl::compute_forces(double hdt) {
         }
       }
       j_start[nc] = at;
-      // The threads' ranges. Pair laws: block b belongs to the thread whose contacts hold its
-      // first contact. Wall laws: the wall detection's ranges. Sums: contiguous ranges of
-      // clumps of about equal work, counted as one per clump and two per pair contact held as
-      // sphere i (each contact is summed on both of its sides, and over a range of clumps the
-      // j sides are about as many as the i sides): where clumps were poured in order, the
-      // first ones lie deepest in the bed, with the most contacts.
-      law_cursors.resize(nt);
-      sum_cursors.resize(nt);
-      wall_cursors.split_evenly(na, nt);
-      auto work = [&](int c) { return std::int64_t(c) + 2 * std::int64_t(i_start[c]); };
-      auto first_clump = [&](int u) {
-        if (u == 0) return 0;
-        if (u == nt) return nc;
-        const std::int64_t target = work(nc) * u / nt;
-        int lo = 0, hi = nc;  // the first clump whose work before it reaches the target
-        while (lo < hi) {
-          const int mid = (lo + hi) / 2;
-          if (work(mid) < target)
-            lo = mid + 1;
-          else
-            hi = mid;
-        }
-        return lo;
-      };
-      for (int u = 0; u < nt; ++u) {
-        law_cursors.set_range(u, (contact_start(u) + kBlock - 1) / kBlock,
-                              (contact_start(u + 1) + kBlock - 1) / kBlock);
-        sum_cursors.set_range(u, first_clump(u), first_clump(u + 1));
-      }
     }
     for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;
 
-    law_cursors.run(t, 1, [&](int b, int) {
+    // Block b goes to the thread whose range holds its first contact.
+    const int b0 = (k0 + kBlock - 1) / kBlock, b1 = (k1 + kBlock - 1) / kBlock;
+    for (int b = b0; b < b1; ++b) {
       double block_elastic = 0.0;
       for (int k = b * kBlock; k < std::min(npc, (b + 1) * kBlock); ++k) {
         PairContactData& pc = pair_contacts[k];
@@ -690,83 +652,100 @@ void World::Impl::compute_forces(double hdt) {
         block_elastic += pc.out.elastic_energy;
       }
       block_energy[b] = block_elastic;
-    });
+    }
 
     // The wall laws, in the ranges of wall_active detect_contacts gave each thread.
-    wall_cursors.run(t, kWallChunk, [&](int a0, int a1) {
-      for (int a = a0; a < a1; ++a) {
-        const int s = wall_active[a];
-        const int n = wall_contact_n[s];
-        if (n == 0) continue;
-        const int c = s_clump[s];
-        const TypeData& ty = types[c_type[c]];
-        for (int k = 0; k < n; ++k) {
-          WallContactData& wc = wall_contacts[a][k];
-          const WallData& wd = walls[wc.wall];
-          const ResolvedContact& lw = law(ty.material, wd.material);
-          const Eigen::Vector3d ri = wc.point - c_x[c];
-          ContactKinematics kin;
-          kin.normal = wc.normal;
-          kin.overlap = wc.overlap;
-          kin.r_star = s_r[s];
-          kin.m_star = ty.mass;
-          kin.radius_i = s_r[s];
-          kin.radius_j = 0.0;
-          if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) kin.arm_i = ri.norm();
-          kin.arm_j = 0.0;
-          kin.omega_i = c_ww[c];
-          kin.omega_j = wd.state.pose.omega;
-          const Eigen::Vector3d vw = wd.state.pose.velocity_at(wc.point);
-          const Eigen::Vector3d spin = c_ww[c].cross(ri);
-          kin.v_rel = c_v[c] + spin - vw;
-          kin.v_rel_damping = c_vp[c] + spin - vw;
-          evaluate_contact(lw, kin, hdt, wall_slots[s][k].history, wc.out);
-          wc.moment = ri.cross(wc.out.force);
-          wc.wall_velocity = vw;
-        }
+#pragma omp for schedule(static)
+    for (int a = 0; a < na; ++a) {
+      const int s = wall_active[a];
+      const int n = wall_contact_n[s];
+      if (n == 0) continue;
+      const int c = s_clump[s];
+      const TypeData& ty = types[c_type[c]];
+      for (int k = 0; k < n; ++k) {
+        WallContactData& wc = wall_contacts[a][k];
+        const WallData& wd = walls[wc.wall];
+        const ResolvedContact& lw = law(ty.material, wd.material);
+        const Eigen::Vector3d ri = wc.point - c_x[c];
+        ContactKinematics kin;
+        kin.normal = wc.normal;
+        kin.overlap = wc.overlap;
+        kin.r_star = s_r[s];
+        kin.m_star = ty.mass;
+        kin.radius_i = s_r[s];
+        kin.radius_j = 0.0;
+        if (lw.rolling && lw.roll.model == RollingModel::kStandardCom) kin.arm_i = ri.norm();
+        kin.arm_j = 0.0;
+        kin.omega_i = c_ww[c];
+        kin.omega_j = wd.state.pose.omega;
+        const Eigen::Vector3d vw = wd.state.pose.velocity_at(wc.point);
+        const Eigen::Vector3d spin = c_ww[c].cross(ri);
+        kin.v_rel = c_v[c] + spin - vw;
+        kin.v_rel_damping = c_vp[c] + spin - vw;
+        evaluate_contact(lw, kin, hdt, wall_slots[s][k].history, wc.out);
+        wc.moment = ri.cross(wc.out.force);
+        wc.wall_velocity = vw;
       }
-    });
+    }
 
-    // Sums (after this barrier every contact's force and the index are in place), then the
-    // implicit damping of each clump that needs it.
-#pragma omp barrier
-    sum_cursors.run(t, kSumChunk, [&](int c_lo, int c_hi) {
-      for (int c = c_lo; c < c_hi; ++c) {
-        Eigen::Vector3d f = Eigen::Vector3d::Zero(), tq = Eigen::Vector3d::Zero();
-        double mroll = 0.0;
-        Eigen::Vector2d load = Eigen::Vector2d::Zero();
-        const TypeData& ty = types[c_type[c]];
-        visit_contacts(
-            c,
-            [&](const PairContactData& pc, bool as_i) {
-              // The force on sphere j is −force; each side has its own rolling torque.
-              const Eigen::Vector3d r = pc.point - c_x[c];
-              const Eigen::Vector3d fc = as_i ? pc.out.force : Eigen::Vector3d(-pc.out.force);
-              f += fc;
-              tq += r.cross(fc);
-              if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
-                load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
-              if (pc.rolling) {
-                tq += as_i ? pc.out.torque_i : pc.out.torque_j;
-                mroll += as_i ? pc.out.roll_i : pc.out.roll_j;
-              }
-            },
-            [&](const WallContactData& wc) {
-              f += wc.out.force;
-              tq += wc.moment;
-              if (law(ty.material, walls[wc.wall].material).rolling)
-                tq += wc.out.torque_i, mroll += wc.out.roll_i;
-              if (implicit) load += dashpot_load(wc.out, ty, wc.point - c_x[c], wc.normal);
-            });
-        c_f[c] = f;
-        c_t[c] = tq;
-        c_mroll[c] = mroll;
-        if (implicit) {
-          c_damp[c] = load;
-          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;
-        }
+    // Sums (the loop above ends in a barrier, so every contact's force and the index are in
+    // place), then the implicit damping of each clump that needs it. Contiguous ranges of
+    // clumps of about equal work, counted as one per clump and two per pair contact held as
+    // sphere i (each contact is summed on both of its sides, and over a range of clumps the j
+    // sides are about as many as the i sides): where clumps were poured in order, the first
+    // ones lie deepest in the bed, with the most contacts.
+    auto work = [&](int c) { return std::int64_t(c) + 2 * std::int64_t(i_start[c]); };
+    const std::int64_t w_all = work(nc);
+    auto first_clump = [&](int u) {
+      if (u == 0) return 0;
+      if (u == nt) return nc;
+      const std::int64_t target = w_all * u / nt;
+      int lo = 0, hi = nc;  // the first clump whose work before it reaches the target
+      while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (work(mid) < target)
+          lo = mid + 1;
+        else
+          hi = mid;
       }
-    });
+      return lo;
+    };
+    const int c_lo = first_clump(t), c_hi = first_clump(t + 1);
+    for (int c = c_lo; c < c_hi; ++c) {
+      Eigen::Vector3d f = Eigen::Vector3d::Zero(), tq = Eigen::Vector3d::Zero();
+      double mroll = 0.0;
+      Eigen::Vector2d load = Eigen::Vector2d::Zero();
+      const TypeData& ty = types[c_type[c]];
+      visit_contacts(
+          c,
+          [&](const PairContactData& pc, bool as_i) {
+            // The force on sphere j is −force; each side has its own rolling torque.
+            const Eigen::Vector3d r = pc.point - c_x[c];
+            const Eigen::Vector3d fc = as_i ? pc.out.force : Eigen::Vector3d(-pc.out.force);
+            f += fc;
+            tq += r.cross(fc);
+            if (implicit && (pc.out.dashpot_n > 0.0 || pc.out.dashpot_t > 0.0))
+              load += 2.0 * dashpot_load(pc.out, ty, r, pc.normal);
+            if (pc.rolling) {
+              tq += as_i ? pc.out.torque_i : pc.out.torque_j;
+              mroll += as_i ? pc.out.roll_i : pc.out.roll_j;
+            }
+          },
+          [&](const WallContactData& wc) {
+            f += wc.out.force;
+            tq += wc.moment;
+            if (law(ty.material, walls[wc.wall].material).rolling)
+              tq += wc.out.torque_i, mroll += wc.out.roll_i;
+            if (implicit) load += dashpot_load(wc.out, ty, wc.point - c_x[c], wc.normal);
+          });
+      c_f[c] = f;
+      c_t[c] = tq;
+      c_mroll[c] = mroll;
+      if (implicit) {
+        c_damp[c] = load;
+        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;
+      }
+    }
     // The contacts' energies, summed per block by the law loop, added in block order: the same
     // sum for any thread count.
 #pragma omp single nowait

@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "clumpkit/dem/world.hpp"
-#include "dem/range_cursors.hpp"
 
 namespace clumpkit::dem {
 
@@ -225,9 +224,6 @@ struct World::Impl {
   // Where each thread's block of pair_contacts starts (threads + 1 entries, the last the
   // count), as detect_contacts wrote them; compute_forces evaluates them on the same threads.
   std::vector<int> contact_block_start;
-  // Per-thread ranges, with the leftovers taken by a free thread, of the wall spheres (wall
-  // detection and laws), the pair laws' blocks and the clumps' sums (range_cursors.hpp).
-  RangeCursors wall_cursors, law_cursors, sum_cursors;
   std::vector<std::pair<double, int>> scratch_max;  // per thread: overlap ratio, pair
   std::vector<int> scratch_overflow;
   // Per-step scratch of compute_forces: each clump's pair contacts (as sphere i: a range of
