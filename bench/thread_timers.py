@@ -9,8 +9,8 @@ end a part included; the segment stop prints the sums per thread after its SEGME
   pair geometry  writing the touching pairs' contact geometry (detect_contacts)
   kinematics     each clump's angular velocity and predicted velocity (compute_forces)
   index          the per-clump contact index, in four parts with its barrier and single
-  pair laws      the pair contacts' laws (its own blocks, then what is left of the other's)
-  wall laws      the wall contacts' laws, with the barrier that ends them (likewise)
+  pair laws      the pair contacts' laws
+  wall laws      the wall contacts' laws, with the barrier that ends them
   sums           each clump's force and torque, and its implicit damping
 
 What it shows: whether two threads each do their half of a part in half the time one thread
@@ -30,12 +30,13 @@ def rep(old, new):
 
 
 def rep_either(pairs):
-    """The first (old, new) whose anchor is there: the code as it is, or with
-    bench/tried/range_cursors.diff applied."""
+    """The first (old, new) whose anchor is there: the code as it is (first), or with
+    bench/tried/range_cursors.diff applied (its threads also take what is left of the
+    other's laws and sums, so those parts include that work)."""
     for old, new in pairs:
         if src.count(old) == 1:
             return rep(old, new)
-    rep(pairs[0][0], pairs[0][1])  # stops, naming the first
+    rep(pairs[0][0], pairs[0][1])  # stops, naming the current code's anchor
 
 
 PARTS = ["kinematics", "index (count)", "index (barrier)", "index (single)", "index (list)",
@@ -60,20 +61,20 @@ rep("    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n",
     "    THREAD_TIMER(3);\n    for (int k = k0; k < k1; ++k) j_list[count[clump_j(k)]++] = k;\n"
     "    THREAD_TIMER(4);\n")
 # With bench/tried/range_cursors.diff the laws and sums are lambdas run by RangeCursors.
-rep_either([("      block_energy[b] = block_elastic;\n    });\n",
-             "      block_energy[b] = block_elastic;\n    });\n    THREAD_TIMER(5);\n"),
-            ("      block_energy[b] = block_elastic;\n    }\n",
-             "      block_energy[b] = block_elastic;\n    }\n    THREAD_TIMER(5);\n")])
-rep_either([("#pragma omp barrier\n    sum_cursors.run(",
-             "#pragma omp barrier\n    THREAD_TIMER(6);\n    sum_cursors.run("),
-            ("    // Sums (the loop above ends in a barrier",
-             "    THREAD_TIMER(6);\n    // Sums (the loop above ends in a barrier")])
-rep_either([("          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });",
-             "          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n"
-             "    });\n    THREAD_TIMER(7);"),
-            ("        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }",
+rep_either([("      block_energy[b] = block_elastic;\n    }\n",
+             "      block_energy[b] = block_elastic;\n    }\n    THREAD_TIMER(5);\n"),
+            ("      block_energy[b] = block_elastic;\n    });\n",
+             "      block_energy[b] = block_elastic;\n    });\n    THREAD_TIMER(5);\n")])
+rep_either([("    // Sums (the loop above ends in a barrier",
+             "    THREAD_TIMER(6);\n    // Sums (the loop above ends in a barrier"),
+            ("#pragma omp barrier\n    sum_cursors.run(",
+             "#pragma omp barrier\n    THREAD_TIMER(6);\n    sum_cursors.run(")])
+rep_either([("        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }",
              "        if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n      }\n    }\n"
-             "    THREAD_TIMER(7);")])
+             "    THREAD_TIMER(7);"),
+            ("          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n    });",
+             "          if (hdt > 0.0 && damp_implicitly(c)) ++n_implicit;\n        }\n      }\n"
+             "    });\n    THREAD_TIMER(7);")])
 # detect_contacts
 rep("    const int t = omp_get_thread_num();\n"
     "    const int k0 = static_cast<int>(std::int64_t(np) * t / nt);",
