@@ -1,5 +1,7 @@
 #include "clumpkit/calibrate/measurements.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -175,11 +177,13 @@ std::vector<std::string> redundancy_warnings(const std::vector<Measurement>& ms,
       if (a.rig != b.rig || a.sample != b.sample || a.setting != b.setting) continue;
       const std::vector<std::string> same = same_measurement_as(a.rig, a.quantity);
       if (std::find(same.begin(), same.end(), b.quantity) == same.end()) continue;
-      out.push_back(name + ":" + std::to_string(a.line) + " (" + a.quantity + ") and line " +
-                    std::to_string(b.line) + " (" + b.quantity + "), " + a.rig +
-                    (a.setting.empty() ? std::string() : " " + a.setting_text()) +
-                    ": one is computed from the other in every rig run, so " +
-                    "chi-squared counts this measurement twice; give one of them");
+      // (fmt, not operator+: GCC 12 warns -Wrestrict on the concatenation, a false positive.)
+      const std::string setting = a.setting.empty() ? std::string() : a.setting_text();
+      out.push_back(fmt::format(
+          "{}:{} ({}) and line {} ({}), {}{}{}: one is computed from the other in every rig run, "
+          "so chi-squared counts this measurement twice; give one of them",
+          name, a.line, a.quantity, b.line, b.quantity, a.rig, a.setting.empty() ? "" : " ",
+          setting));
     }
   return out;
 }

@@ -72,4 +72,7 @@ class SpreadPool {
 /// Mean and sample standard deviation of repeats.
 SimulatedValue summarize(const std::vector<double>& repeats);
 
+/// Survival function of the chi-square distribution, P(X >= x) with `dof` degrees of freedom.
+double chi2_survival(double x, int dof);
+
 }  // namespace clumpkit

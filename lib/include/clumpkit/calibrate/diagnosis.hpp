@@ -141,7 +141,4 @@ std::string interval_text(const CandidateResult& r);
 /// SJKR energy density = 8750 J/m^3)".
 std::string parameter_text(const CandidateResult& r);
 
-/// Survival function of the chi-square distribution, P(X >= x) with `dof` degrees of freedom.
-double chi2_survival(double x, int dof);
-
 }  // namespace clumpkit::calibrate

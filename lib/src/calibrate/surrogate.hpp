@@ -1,0 +1,109 @@
+#pragma once
+/// The diagnosis's response surrogates (diagnosis.cpp): how the simulated observables change
+/// with one candidate effect's strength, fitted through the rig runs made so far, and the fits
+/// of that strength (alone, or two effects at once) to the measurements, with their
+/// uncertainties. No simulation happens here.
+#include <limits>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "clumpkit/calibrate/comparison.hpp"
+
+namespace clumpkit::calibrate {
+
+/// Simulated observables keyed by Measurement::key().
+using Values = std::map<std::string, SimulatedValue>;
+
+/// Response surrogate of one candidate through its simulated points (theta, values): a line
+/// through two points, a least-squares parabola through three or more, continued as a straight
+/// line (its tangent) beyond the points. Each point is a mean of a few noisy repeats, so the
+/// surrogate smooths rather than interpolates: a piecewise-linear interpolant takes its slope
+/// from the two nearest points, and two nearby refinement points give a slope that is mostly
+/// seed noise (and with it a fitted uncertainty several times too small).
+/// A rig's response over a candidate's whole range is often no parabola (the packing falls
+/// fast with the first bit of cohesion, then levels off; a heap's angle rises slowly, then
+/// steeply): where the parabola misses its points by more than their seed noise (a lack-of-fit
+/// chi2 test at 1 %), the points farthest from the `focus` (where the fit is being made) are
+/// dropped, down to three, so the surrogate is local where it must be and smooth where it can be.
+class Surrogate {
+ public:
+  /// A fit misses its points by more than their seed noise when a miss this large has a
+  /// probability below this (chi2 test).
+  static constexpr double kLackOfFit = 0.01;
+  std::vector<std::pair<double, Values>> points;  ///< sorted by theta
+
+  /// Adds (or replaces) the point at `theta`.
+  void add(double theta, Values v);
+  /// Where the next fit is made, and the pooled seed-to-seed spread of one run per observable
+  /// (the noise the lack-of-fit test weighs the points' misses by).
+  void aim(double theta, const Values& pooled);
+  /// The surrogate's mean of observable `key` at `theta`.
+  double value(const std::string& key, double theta) const;
+  /// Variance of a simulated mean through the surrogate, averaged over its points: each point's
+  /// own seed scatter (std^2/n) where it has repeats, the pooled per-run variance `run_var` for
+  /// a single-run (screening) point; never below the baseline's `run_var / base_n`. Heaps with
+  /// more rolling friction scatter more than the baseline's (tiny scale: 2-4 deg against 1.6),
+  /// so the baseline's scatter alone understated the fitted uncertainty.
+  double noise_var(const std::string& key, double run_var, int base_n) const;
+
+ private:
+  struct Poly {
+    double mid = 0, half = 1, a = 0, b = 0, c = 0;  ///< a + b x + c x^2, x = (t - mid) / half
+    double lo = 0, hi = 0;                          ///< span of the points it follows
+  };
+  /// (theta, mean, repeats) of the points, for one observable.
+  struct Pt {
+    double t, y;
+    int n;
+  };
+  mutable std::map<std::string, Poly> coef;
+  double focus = std::numeric_limits<double>::quiet_NaN();
+  std::map<std::string, double> run_var;
+
+  /// Lack of fit of `p` at the points, in units of their seed noise (`var`: one run's
+  /// variance), as the probability of a miss this large from noise alone.
+  static double fits_within_noise(const Poly& p, const std::vector<Pt>& pts, double var);
+  /// The least-squares line or parabola through the points (`var`: one run's seed variance,
+  /// 0 if unknown).
+  static Poly fit(const std::vector<Pt>& pts, double var);
+  /// The fit of observable `key`, made local around `focus` where one parabola misses.
+  const Poly& poly(const std::string& key) const;
+};
+
+/// Variance of each measurement's difference from the surrogate: the lab's and the
+/// simulations' (the same for every theta of one fit).
+std::vector<double> fit_variances(const std::vector<Measurement>& ms, const Values& base,
+                                  const Surrogate& s);
+
+/// chi2 of the measurements against the surrogate at `theta`, with the variances `var`.
+double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& var,
+               const Surrogate& s, double theta);
+
+/// One candidate's strength fitted on its surrogate.
+struct Fit {
+  double theta = 0, chi2 = 0, sigma = 0;
+  double lo95 = 0, hi95 = 0;  ///< Delta chi2 = 4 on the surrogate (asymmetric where it levels off)
+};
+
+/// The least chi2 over [lo, hi] (a grid of 2 000 steps); sigma: half the Delta chi2 = 1
+/// interval, an open side extending to the range's bound.
+Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
+                  double lo, double hi);
+
+/// Two continuous candidates at once, on the sum of their one-effect surrogates: the responses
+/// to a and to b add (each surrogate's change from its own baseline), plus `offset`, what a run
+/// of the pair showed the sum to miss (the interaction). chi2 on a grid over both ranges; each
+/// parameter's uncertainty from its profile (the least chi2 over the other).
+struct PairFitResult {
+  double ta = 0, tb = 0, chi2 = std::numeric_limits<double>::infinity();
+  double sa = 0, sb = 0, lo_a = 0, hi_a = 0, lo_b = 0, hi_b = 0;
+};
+
+PairFitResult fit_pair(const std::vector<Measurement>& ms, const Values& pooled, const Surrogate& a,
+                       double base_a, std::pair<double, double> range_a, const Surrogate& b,
+                       double base_b, std::pair<double, double> range_b,
+                       const std::vector<double>& offset);
+
+}  // namespace clumpkit::calibrate

@@ -1,0 +1,207 @@
+// The pocket-wheel discharger (SPEC §7): a hopper over an 8-pocket wheel turning at a
+// given rpm; the mass each pocket carries out and the discharged mass over time.
+#include "procedure.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/dem/world.hpp"
+#include "clumpkit/rigs/geometry.hpp"
+#include "clumpkit/rigs/heap_angle.hpp"
+#include "clumpkit/rigs/pictures.hpp"
+
+namespace clumpkit::rigs::detail {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+RepeatResult discharge(Ctx& c) {
+  const ScaleParams& p = c.p;
+  WheelGeometry g;
+  const double s = p.wheel_scale;
+  g.outer_radius *= s, g.hub_radius *= s, g.hopper_opening *= s, g.hopper_top_width *= s;
+  g.hopper_height *= s;
+  g.length = p.slice_length;
+  const double br = max_bound_radius(c);
+  if (g.length < 2.0 * br + 0.001)
+    throw InputError(
+        "--set", "slice",
+        fmt::format("{:.1f} mm is narrower than one pill ({:.1f} mm)", g.length * 1e3, 2e3 * br));
+  const std::vector<std::string> mats = {"abs_plastic", "galvanized_steel"};
+  dem::WorldSettings ws = base_settings(c, mats);
+  ws.source = "discharge rig";
+  auto wheel = [&](double t_on) {
+    dem::WallSettings w{"wheel", wheel_mesh(g), "abs_plastic", {}, {}};
+    dem::WallRotation rot;
+    rot.axis_point = Vector3d(0, 0, g.axis_height);
+    rot.axis = Vector3d::UnitY();
+    rot.rpm = p.rpm;
+    rot.start_time = t_on;
+    w.motion.rotation = rot;
+    return w;
+  };
+  ws.walls.push_back({"housing", housing_mesh(g), "galvanized_steel", {}, {}});
+  ws.walls.push_back({"hopper", hopper_mesh(g), "galvanized_steel", {}, {}});
+  ws.walls.push_back({"ends", end_plates_mesh(g), "galvanized_steel", {}, {}});
+  const double z_out = g.axis_height - g.outer_radius - g.housing_gap - 0.01;
+  ws.walls.push_back({"catch",
+                      dem::make_plane(Vector3d(0, 0, z_out - 0.06), Vector3d::UnitZ(), 0.6, 0.6),
+                      "galvanized_steel",
+                      {},
+                      {}});
+  ws.walls.push_back(wheel(1e9));
+  // Hopper capacity: the cone plus its vertical extension, at the pills' densest packing.
+  const double tan_a = std::tan(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
+  const double hc = 0.5 * (g.hopper_top_width - g.hopper_opening) / tan_a;
+  const double hopper_volume = g.length * (0.5 * (g.hopper_opening + g.hopper_top_width) * hc +
+                                           g.hopper_top_width * g.hopper_height);
+  const double cap = 0.74 * mean_union_density(c) * hopper_volume;
+  if (p.bed_mass > cap)
+    throw InputError("--set", "scale",
+                     fmt::format("the {} scale's hopper holds at most {:.3f} kg, not {:.3f} kg",
+                                 p.name, cap, p.bed_mass));
+  const double zt = g.throat_z();
+  const double ymax = 0.5 * g.length - 0.0005;
+  const dem::BoxRegion box{
+      Vector3d(-0.5 * g.hopper_top_width + 0.002, -ymax, zt + 0.4 * hc),
+      Vector3d(0.5 * g.hopper_top_width - 0.002, ymax, zt + hc + g.hopper_height)};
+  ws.factories.push_back(pour(c, box, p.bed_mass));
+
+  const int wheel_wall = int(ws.walls.size()) - 1;
+  // Pills below the outlet have been discharged: removed from the World, their mass counted.
+  c.outside = [z_out](const Vector3d& x) { return x.z() < z_out; };
+
+  nlohmann::json state = load_state(c);
+  dem::World w = open_world(c, ws, state, "fill hopper");
+  if (state.value("phase", 0) < 2) {
+    const SettleInfo s1 = pour_and_settle(c, w, "fill hopper");
+    snapshot(c, w, "bed");
+    const double t_on = w.time() + 0.01;
+    // Pills that leaked through the outlet while the wheel stood still are not counted.
+    state = {{"t_action", t_on},
+             {"fill_time_s", w.time()},
+             {"settle_fill", settle_json(s1)},
+             {"leaked_kg", c.removed_mass}};
+    c.removed_mass = 0.0;
+    state["removed_kg"] = 0.0;
+    start_action(c, w, wheel_wall, wheel(t_on).motion, state);
+  }
+  const double t0 = state.at("t_action");
+  c.removed_mass = state.value("removed_kg", 0.0);
+
+  const double omega = p.rpm * 2.0 * std::numbers::pi / 60.0;  // rad/s, about +y: angles decrease
+  const double pitch = 2.0 * std::numbers::pi / g.pockets;
+  const double period = pitch / omega;
+  const double rh = g.outer_radius + g.housing_gap;
+  const double throat = std::acos(0.5 * g.hopper_opening / rh);  // right throat edge angle
+  // Pocket k lies between vanes k and k+1: angles [a_k, a_k + pitch], a_k(t) = k·pitch − ω(t−t0).
+  // It closes when its upper vane passes below the throat edge.
+  struct Pocket {
+    double t_close;
+    int k;
+  };
+  std::vector<Pocket> pockets;
+  for (int k = 0; k < g.pockets; ++k) {
+    double upper = (k + 1) * pitch;
+    while (upper <= throat) upper += 2.0 * std::numbers::pi;
+    while (upper > throat + 2.0 * std::numbers::pi) upper -= 2.0 * std::numbers::pi;
+    pockets.push_back({t0 + (upper - throat) / omega, k});
+  }
+  std::sort(pockets.begin(), pockets.end(), [](auto& a, auto& b) { return a.t_close < b.t_close; });
+  const int need = p.pockets_skipped + p.pockets_measured;
+  while (int(pockets.size()) < need) {
+    Pocket q = pockets[pockets.size() - g.pockets];
+    q.t_close += 2.0 * std::numbers::pi / omega;
+    pockets.push_back(q);
+  }
+  const double settle_delay = 0.05 * period;
+  const double t_end = pockets[need - 1].t_close + settle_delay;
+
+  // Progress of phase 2 lives in the state (saved with every checkpoint), so a resumed run
+  // continues the pocket count and the discharge curve.
+  std::vector<double> fills = state.value("fills", std::vector<double>{});
+  std::vector<double> curve_t = state.value("curve_t", std::vector<double>{});
+  std::vector<double> curve_m = state.value("curve_m", std::vector<double>{});
+  size_t next = state.value("next_pocket", size_t(0));
+  const double sample = period / 10.0;
+  double t_next_sample = state.value("t_next_sample", w.time());
+  const double L = g.length;
+  while (true) {
+    const double t_next_pocket = next < size_t(need) ? pockets[next].t_close + settle_delay : 1e300;
+    const double target = std::min({t_end, t_next_pocket, t_next_sample});
+    if (target > w.time()) w.run_until(target);
+    cull(c, w);
+    if (w.time() >= t_next_sample - 1e-12) {
+      curve_t.push_back(w.time() - t0);
+      curve_m.push_back(c.removed_mass);
+      t_next_sample += sample;
+    }
+    if (next < size_t(need) && w.time() >= t_next_pocket - 1e-12) {
+      const double lower = pockets[next].k * pitch - omega * (w.time() - t0);
+      double m = 0;
+      for (int i = 0; i < w.clump_count(); ++i) {
+        const Vector3d& x = w.positions()[i];
+        const double r = std::hypot(x.x(), x.z() - g.axis_height);
+        if (r < g.hub_radius || r > rh || std::abs(x.y()) > 0.5 * L) continue;
+        double a = std::atan2(x.z() - g.axis_height, x.x()) - lower;
+        a = std::fmod(a, 2.0 * std::numbers::pi);
+        if (a < 0) a += 2.0 * std::numbers::pi;
+        if (a < pitch) m += w.clump_mass(i);
+      }
+      if (int(next) >= p.pockets_skipped) fills.push_back(m);
+      c.say(fmt::format("pocket {} closed at t = {:.3f} s: {:.4f} kg in the slice", next + 1,
+                        w.time(), m));
+      ++next;
+    }
+    state["fills"] = fills, state["curve_t"] = curve_t, state["curve_m"] = curve_m;
+    state["next_pocket"] = next, state["t_next_sample"] = t_next_sample;
+    state["removed_kg"] = c.removed_mass;
+    keep_checkpoint(c, w, 2, state, false);
+    if (w.time() >= t_end - 1e-12 && next >= size_t(need)) break;
+    c.progress([&] {
+      return fmt::format(
+          "discharge: t = {:.3f} of {:.3f} s, {} of {} pockets closed, {:.4f} kg out", w.time(),
+          t_end, next, need, c.removed_mass);
+    });
+  }
+  snapshot(c, w, "discharged");
+
+  double mean = 0, ss = 0;
+  for (double f : fills) mean += f / fills.size();
+  for (double f : fills) ss += (f - mean) * (f - mean);
+  const double sd = fills.size() > 1 ? std::sqrt(ss / (fills.size() - 1)) : 0.0;
+  // Extrapolation from the slice to the paper's full pocket (100 mm long, full-size wheel).
+  const double to_paper = 0.100 / L / (s * s);
+  RepeatResult r;
+  r.values["pocket_mass"] = mean * to_paper;
+  r.values["pocket_mass_cv"] = mean > 0 ? sd / mean : 0.0;
+  r.values["mass_flow"] = mean * to_paper * g.pockets * p.rpm / 60.0;
+  r.details = {{"pocket_mass_slice_kg", mean},
+               {"pocket_fills_slice_kg", fills},
+               {"slice_to_paper_factor", to_paper},
+               {"pocket_period_s", period},
+               {"pocket_volume_m3", g.pocket_volume()},
+               {"rpm", p.rpm},
+               {"discharged_mass_kg", curve_m.empty() ? 0.0 : curve_m.back()},
+               {"curve_time_s", curve_t},
+               {"curve_mass_kg", curve_m},
+               {"settle_fill", state["settle_fill"]},
+               {"leaked_before_start_kg", state.value("leaked_kg", 0.0)},
+               {"pills", w.clump_count()},
+               {"simulated_time_s", w.time()},
+               {"time_step_s", w.dt()},
+               {"pinched", pinch_json(c, w)},
+               {"profile", profile_json(c, w, c.meter.sphere_steps)}};
+  if (!c.dir.empty())
+    curve_picture(c.dir / "discharge.png", {{fmt::format("{:g} rpm", p.rpm), curve_t, curve_m}},
+                  "t s", "m kg");
+  return r;
+}
+
+}  // namespace clumpkit::rigs::detail

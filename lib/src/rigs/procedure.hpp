@@ -1,0 +1,133 @@
+#pragma once
+/// What the three rigs share (rig.cpp runs them; bulk_density.cpp, angle_of_repose.cpp and
+/// discharge.cpp each follow the paper's procedure): one repeat's context, the engine settings
+/// of a rig, the pour, settling by the kinetic-energy criterion, the checkpoints that make a
+/// killed repeat resumable, and the hand-over from the pour (phase 1) to the rig's action
+/// (phase 2).
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "clumpkit/dem/world.hpp"
+#include "clumpkit/geometry/sphere.hpp"
+#include "clumpkit/rigs/rig.hpp"
+
+namespace clumpkit::rigs::detail {
+
+using Clock = std::chrono::steady_clock;
+
+/// Sphere-steps are counted at every settle/action check (the sphere count changes as pills are
+/// poured and removed).
+struct Meter {
+  double sphere_steps = 0.0;
+  long last_steps = 0;
+  void tick(const dem::World& w) {
+    sphere_steps += double(w.step_count() - last_steps) * double(w.sphere_count());
+    last_steps = w.step_count();
+  }
+};
+
+/// One repeat of a rig.
+struct Ctx {
+  const RigRequest& req;
+  ScaleParams p;
+  std::vector<dem::ClumpTypeSettings> types;  // filled once per run
+  std::filesystem::path dir;                  // this repeat's folder, may be empty
+  std::uint64_t seed = 1;
+  int repeat = 0;
+  Clock::time_point last_checkpoint = Clock::now();
+  Clock::time_point last_progress = Clock::now();
+  // Clumps whose centre satisfies `outside` have left the rig for good (overflow, discharge,
+  // fallen off the plate): removed from the World; `removed_mass` totals them (phase 2 only
+  // resumes it from the state, see discharge).
+  std::function<bool(const Eigen::Vector3d&)> outside = nullptr;
+  double removed_mass = 0.0;
+  Meter meter = {};
+
+  void say(const std::string& s) const {
+    if (req.progress) req.progress(fmt::format("[{} repeat {}] {}", req.rig, repeat + 1, s));
+  }
+  // A progress line at most every 5 s of wall time on the long loops (pour, strike-off, lift,
+  // discharge); `line` is formatted only when one is due.
+  template <class F>
+  void progress(F&& line) {
+    if (std::chrono::duration<double>(Clock::now() - last_progress).count() <= 5.0) return;
+    say(line());
+    last_progress = Clock::now();
+  }
+};
+
+/// The rigs' procedures, one repeat each (SPEC §7): pour, settle, the rig's action, measure.
+RepeatResult bulk_density(Ctx& c);
+RepeatResult angle_of_repose(Ctx& c);
+RepeatResult discharge(Ctx& c);
+
+/// The engine settings every rig starts from: the model's materials (stiffness scaled by the
+/// scale), clump types and contact laws against `wall_materials`, the scale's step and damping.
+dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& wall_materials);
+/// The model's mean density of the sphere unions, kg/m^3, weighted by the mixture's fractions.
+double mean_union_density(const Ctx& c);
+/// The largest distance of a sphere's surface from its clump's centre, m.
+double max_bound_radius(const Ctx& c);
+/// A factory pouring `mass` into `region`: all at once when the region can hold it at a loose
+/// 20 % solid fraction, else at the scale's pour rate or as fast as the region can take pills,
+/// whichever is slower (the small scale's cup asked more of its pour region per batch than
+/// random insertion could place, and the factory stopped the run as falling behind).
+dem::FactorySettings pour(const Ctx& c, const dem::Region& region, double mass);
+/// The engine checkpoint and the rig's state (state.json: phase, lift end, pocket fills, ...) are
+/// one commit: the checkpoint goes to a new file named by phase and step, then state.json names
+/// it (atomic rename), then older checkpoints are deleted. A kill at any moment leaves a
+/// state.json and the checkpoint it names, taken at the same step. (Writing both under fixed
+/// names let a kill between the two writes pair a new checkpoint with an old state: a resume in
+/// the middle of the angle-of-repose lift then stopped the tube twice, 26.3477° instead of
+/// 26.3464°.) Written every RigRequest::checkpoint_interval of wall time, or `now`.
+void keep_checkpoint(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra, bool now);
+/// RMS clump speed, m/s (from the kinetic energy and the total mass).
+double rms_speed(const dem::World& w);
+/// The engine's stage profile and throughput, for the JSON and the progress stream.
+nlohmann::json profile_json(const Ctx& c, const dem::World& w, double sphere_steps);
+/// Pills taken out by the pinch release: said once, and listed in the repeat's details.
+nlohmann::json pinch_json(const Ctx& c, const dem::World& w);
+/// Removes the clumps that have left the rig (Ctx::outside); returns their mass, kg.
+double cull(Ctx& c, dem::World& w);
+
+struct SettleInfo {
+  bool settled = false;
+  double time = 0.0;     // s simulated in this settle
+  double rms_speed = 0;  // m/s at the end
+};
+
+/// Runs until the factories are done and the RMS clump speed stays below the scale's threshold
+/// for 3 checks 10 ms apart, or until settle_max of simulated time after the factories finished
+/// (constant-torque rolling friction can keep a few pills creeping: the bed counts as settled
+/// then, and the details say so). Resumes its own bookkeeping from a checkpoint taken inside it.
+SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
+                  const std::string& what);
+nlohmann::json settle_json(const SettleInfo& s);
+/// The World's spheres (positions and radii).
+Spheres world_spheres(const dem::World& w);
+/// VTK files of the spheres and walls, `name`_*.vtp in the repeat's folder, if asked for.
+void snapshot(const Ctx& c, const dem::World& w, const std::string& name);
+/// A wall velocity `v` from t_on to t_off (infinite: for ever), with 0.1 ms ramps.
+dem::VelocityProfile step_velocity(double t_on, double t_off, const Eigen::Vector3d& v);
+/// The repeat's state.json ({"phase": 0} if none or unreadable).
+nlohmann::json load_state(const Ctx& c);
+/// The repeat's World: created from `ws` (walls at rest), then restored from the checkpoint of
+/// the phase the state names, if any (the checkpoint carries the walls' motions).
+dem::World open_world(Ctx& c, const dem::WorldSettings& ws, const nlohmann::json& state,
+                      const std::string& what);
+/// Phase 1: pour and settle.
+SettleInfo pour_and_settle(Ctx& c, dem::World& w, const std::string& what,
+                           const nlohmann::json& extra = {});
+/// Phase 2 begins: the action's wall starts moving in the same World (contact histories kept).
+void start_action(Ctx& c, dem::World& w, int wall, const dem::WallMotion& m, nlohmann::json& state);
+
+}  // namespace clumpkit::rigs::detail
