@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
@@ -34,10 +37,12 @@ fs::path find_model(const std::string& arg, const std::string& field) {
   const fs::path dir = data_dir() / "shapes" / "models";
   for (const fs::path& cand : {dir / (arg + ".toml"), dir / arg})
     if (fs::exists(cand, ec)) return cand;
-  std::string known;
+  std::vector<std::string> names;  // in name order (the directory's order is the file system's)
   for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().extension() == ".toml")
-      known += (known.empty() ? "" : ", ") + e.path().stem().string();
+    if (e.path().extension() == ".toml") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  std::string known;
+  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
   throw InputError("", field,
                    "unknown model '" + arg + "': not a file, nor a bundled model (" + known + ")");
 }

@@ -368,6 +368,18 @@ TEST(ExportWrite, CreatesTheFolderAndOverwritesWholeFiles) {
   EXPECT_EQ(test::listing(dir), std::vector<std::string>{"pill_B_12.mol"});
 }
 
+TEST(ExportWrite, AFolderNamedWithATrailingSlashIsCreated) {
+  // `clumpkit export a12.json --format liggghts -o liggghts_a12/` (the README's tour): the
+  // folder's parent is the working folder, not "liggghts_a12".
+  const fs::path base = test::scratch_dir("");
+  for (const std::string name : {"one/", "two//"}) {
+    const fs::path dir = base / name;
+    export_clump(test::pill_template(), "lammps", dir);
+    EXPECT_EQ(test::listing(base / name.substr(0, 3)), std::vector<std::string>{"pill_B_12.mol"})
+        << name;
+  }
+}
+
 TEST(ExportWrite, AFolderInTheWayOfOneFileWritesNoneOfThem) {
   const fs::path dir = test::scratch_dir("");
   fs::create_directory(dir / "pill_B_12.liggghts");

@@ -90,9 +90,13 @@ void cleanup(const std::vector<fs::path>& temps, const std::vector<fs::path>& di
 
 }  // namespace
 
-std::vector<fs::path> write_export(const std::vector<ExportFile>& files, const fs::path& folder) {
+std::vector<fs::path> write_export(const std::vector<ExportFile>& files,
+                                   const fs::path& folder_arg) {
   std::error_code ec;
-  if (folder.empty()) throw InputError("", "-o", "empty output folder");
+  if (folder_arg.empty()) throw InputError("", "-o", "empty output folder");
+  // "out/" names the folder "out" (its parent is "."), as a shell user means it.
+  fs::path folder = folder_arg;
+  while (!folder.has_filename() && folder.has_relative_path()) folder = folder.parent_path();
   if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
     throw InputError(folder.string(), "-o", "exists and is not a folder");
   // Check every target before touching the disk.
