@@ -2,18 +2,12 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numbers>
 #include <optional>
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
-#include "clumpkit/dem/world.hpp"
-#include "clumpkit/rigs/geometry.hpp"
-#include "clumpkit/rigs/heap_angle.hpp"
-#include "clumpkit/rigs/pictures.hpp"
 #include "procedure.hpp"
 
 namespace clumpkit::rigs {
