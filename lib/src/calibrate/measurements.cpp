@@ -178,12 +178,12 @@ std::vector<std::string> redundancy_warnings(const std::vector<Measurement>& ms,
       const std::vector<std::string> same = same_measurement_as(a.rig, a.quantity);
       if (std::find(same.begin(), same.end(), b.quantity) == same.end()) continue;
       // (fmt, not operator+: GCC 12 warns -Wrestrict on the concatenation, a false positive.)
-      const std::string setting = a.setting.empty() ? std::string() : a.setting_text();
+      const std::string where =
+          a.setting.empty() ? a.rig : fmt::format("{} {}", a.rig, a.setting_text());
       out.push_back(fmt::format(
-          "{}:{} ({}) and line {} ({}), {}{}{}: one is computed from the other in every rig run, "
-          "so chi-squared counts this measurement twice; give one of them",
-          name, a.line, a.quantity, b.line, b.quantity, a.rig, a.setting.empty() ? "" : " ",
-          setting));
+          "{}:{} ({}) and line {} ({}), {}: one is computed from the other in every rig run, so "
+          "chi-squared counts this measurement twice; give one of them",
+          name, a.line, a.quantity, b.line, b.quantity, where));
     }
   return out;
 }

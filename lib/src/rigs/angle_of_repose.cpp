@@ -7,9 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <optional>
 
-#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/dem/world.hpp"
 #include "clumpkit/rigs/geometry.hpp"
@@ -18,7 +16,6 @@
 
 namespace clumpkit::rigs::detail {
 
-namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
 namespace {

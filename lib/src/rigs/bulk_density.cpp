@@ -6,19 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
-#include <optional>
 
-#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/dem/world.hpp"
 #include "clumpkit/rigs/geometry.hpp"
-#include "clumpkit/rigs/heap_angle.hpp"
-#include "clumpkit/rigs/pictures.hpp"
 
 namespace clumpkit::rigs::detail {
 
-namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
 RepeatResult bulk_density(Ctx& c) {
