@@ -4,7 +4,8 @@
 #   sanitize  ASan + UBSan (+ libFuzzer coverage), tests labelled `sanitize`: every module's fast
 #             tests, the fuzz corpus replays and the bad-input catalogue        -> ${build}-asan/
 #   tsan      ThreadSanitizer (OpenMP via LLVM's Archer), tests labelled `tsan`  -> ${build}-tsan/
-#   fuzz      every libFuzzer target of the sanitize build, CLUMPKIT_FUZZ_SECONDS in total (40)
+#   fuzz      every libFuzzer target of the sanitize build, CLUMPKIT_FUZZ_SECONDS of fuzzing in
+#             total (40), shared equally, as many targets at once as there are cores
 # Tests labelled `slow` stay out of both sanitizer builds. All stages run by default (CI); for
 # quick local runs CLUMPKIT_CI_QUICK=1 skips the three, CLUMPKIT_CI_SKIP="tsan fuzz" some of them.
 # Called by .ci/bootstrap test. Prints each stage's wall time at the end.

@@ -10,14 +10,14 @@
 #include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
+extern const char* const kFuzzTargetName;  // generated per target by tests/fuzz/CMakeLists.txt
 
 namespace {
 
 namespace fs = std::filesystem;
 
 std::vector<fs::path> inputs(const std::string& folder) {
-  const fs::path dir =
-      fs::path(CLUMPKIT_SOURCE_DIR) / "tests" / "fuzz" / folder / CLUMPKIT_FUZZ_NAME;
+  const fs::path dir = fs::path(CLUMPKIT_SOURCE_DIR) / "tests" / "fuzz" / folder / kFuzzTargetName;
   std::vector<fs::path> out;
   if (!fs::is_directory(dir)) return out;
   for (const auto& e : fs::directory_iterator(dir))

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Fuzzes every target of a CLUMPKIT_FUZZ=ON build, one after the other, each for a time budget,
-# starting from the committed seed corpus (which is never modified: new inputs go to a scratch
+# Fuzzes every target of a CLUMPKIT_FUZZ=ON build, each for a time budget, as many at once as the
+# machine has cores ($CLUMPKIT_FUZZ_JOBS to change it; libFuzzer runs one process each), starting
+# from the committed seed corpus (which is never modified: new inputs go to a scratch
 # folder). Prints one line per target (executions, crashes) and exits 1 if any target crashed,
 # leaked, timed out or ran out of memory; the offending input is kept in <build>/fuzz-artifacts/.
 #   bash tests/fuzz/run.sh BUILD SECONDS_PER_TARGET [TARGET...]
@@ -27,19 +28,21 @@ dict_for() {
 }
 # Leaks inside third-party libraries (assimp) are suppressed, ours are not (lsan.supp).
 export LSAN_OPTIONS="suppressions=$here/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
-failed=0
-for t in "${targets[@]}"; do
-  bin="$build/tests/fuzz/fuzz_$t"
-  [ -x "$bin" ] || { echo "fuzz $t: missing $bin" >&2; failed=1; continue; }
+fuzz_one() {  # target: fuzzes it, then writes its one-line result to $scratch/<target>.result
+  local t="$1" bin="$build/tests/fuzz/fuzz_$1" dict log start rc runs status
+  local args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=8192
+              -print_final_stats=1 -artifact_prefix="$artifacts/$t-")
+  if [ ! -x "$bin" ]; then
+    echo "fuzz $t: missing $bin, FAILED" > "$scratch/$t.result"
+    return
+  fi
   mkdir -p "$scratch/$t"
-  args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=8192
-        -print_final_stats=1 -artifact_prefix="$artifacts/$t-")
   dict="$(dict_for "$t")"
   [ -n "$dict" ] && [ -f "$dict" ] && args+=(-dict="$dict")
   log="$artifacts/$t.log"
   start=$(date +%s)
   # Corpus folders that exist (git does not keep an empty regressions/<target>/).
-  dirs=("$scratch/$t")
+  local dirs=("$scratch/$t")
   for d in "$here/corpus/$t" "$here/regressions/$t"; do [ -d "$d" ] && dirs+=("$d"); done
   "$bin" "${args[@]}" "${dirs[@]}" >"$log" 2>&1
   rc=$?
@@ -48,8 +51,20 @@ for t in "${targets[@]}"; do
   if [ "$rc" -ne 0 ]; then
     status="FAILED (exit $rc, see $log)"
     grep -E 'ERROR|invariant|what\(\)|SUMMARY' "$log" | head -5 >&2
-    failed=1
   fi
-  echo "fuzz $t: ${runs:-?} executions in $(( $(date +%s) - start )) s, $status"
+  echo "fuzz $t: ${runs:-?} executions in $(( $(date +%s) - start )) s, $status" \
+    > "$scratch/$t.result"
+}
+
+at_once="${CLUMPKIT_FUZZ_JOBS:-$(nproc)}"
+for t in "${targets[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$at_once" ]; do wait -n; done
+  fuzz_one "$t" &
+done
+wait
+failed=0
+for t in "${targets[@]}"; do
+  cat "$scratch/$t.result"
+  grep -q "FAILED" "$scratch/$t.result" && failed=1
 done
 exit "$failed"
