@@ -153,8 +153,8 @@ RigSimulator::Entry RigSimulator::entry(const ParticleModel& model, const SimReq
                                         int repeats, std::uint64_t seed) const {
   Entry e;
   e.model = model_for_sample(model, req.sample, model.path.string());
-  e.key = fmt::format("{}|{}|{}|{}|engine {}", req.key(), seed, repeats, model_fingerprint(e.model),
-                      dem::kPhysicsRevision);
+  e.key = fmt::format("{}|{}|{}|{}|engine {} rigs {}", req.key(), seed, repeats,
+                      model_fingerprint(e.model), dem::kPhysicsRevision, rigs::kRigsRevision);
   const std::string id = fmt::format("{:016x}", std::hash<std::string>{}(e.key));
   e.file = opt_.cache_dir / (req.rig + "_" + id + ".json");
   e.run_dir = opt_.cache_dir / ("run_" + req.rig + "_" + id);

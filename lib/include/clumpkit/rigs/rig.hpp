@@ -20,6 +20,11 @@
 
 namespace clumpkit::rigs {
 
+/// Changes whenever a rig gives different results for the same model, settings, scale and seed
+/// (caches of rig results key on it, beside dem::kPhysicsRevision): 1 = session 30's 24 mm
+/// wheel slice at `tiny` (12 mm arched above the throat).
+inline constexpr int kRigsRevision = 1;
+
 /// Numbers that size a rig at one scale. Defaults are filled by rig_scale(); every field is
 /// reported in the result's JSON so a run documents itself.
 struct ScaleParams {
