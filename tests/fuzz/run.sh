@@ -64,7 +64,12 @@ done
 wait
 failed=0
 for t in "${targets[@]}"; do
-  cat "$scratch/$t.result"
-  grep -q "FAILED" "$scratch/$t.result" && failed=1
+  if [ -f "$scratch/$t.result" ]; then
+    cat "$scratch/$t.result"
+    grep -q "FAILED" "$scratch/$t.result" && failed=1
+  else
+    echo "fuzz $t: no result, FAILED"
+    failed=1
+  fi
 done
 exit "$failed"
