@@ -50,7 +50,8 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
       // (~100-250 pills per rig). Observables are noisier and further from paper scale. The
       // wheel keeps mini's 24 mm slice: in 12 mm (until session 30) the pocket fills at 15 rpm
       // were 2.6, 0, 0 g (seed 1); in 24 mm, with the bed doubled to keep its depth, 6.2, 6.3,
-      // 5.8 g (seeds 2, 3: 5.0-6.0, 5.9-6.5 g) in 17 s instead of 9 s (docs/rigs.md).
+      // 5.8 g for seed 1 (seeds 2, 3: 5.0-6.0, 5.9-6.5 g) in 17 s instead of 9 s; 6-16 % of
+      // what passes the wheel is pinched, 2-4 % at mini (docs/rigs.md).
       p.cup_diameter = 0.030, p.cup_height = 0.029;
       p.heap_mass = 0.03, p.tube_diameter = 0.036, p.tube_height = 0.09, p.lift_speed = 0.05;
       p.settle_max = 0.5;
