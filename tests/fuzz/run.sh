@@ -10,6 +10,11 @@ set -uo pipefail
 build="${1:?usage: run.sh BUILD SECONDS_PER_TARGET [TARGET...]}"
 seconds="${2:?usage: run.sh BUILD SECONDS_PER_TARGET [TARGET...]}"
 shift 2
+at_once="${CLUMPKIT_FUZZ_JOBS:-$(nproc)}"
+if ! [[ "$at_once" =~ ^[1-9][0-9]*$ ]]; then
+  echo "run.sh: CLUMPKIT_FUZZ_JOBS must be a whole number >= 1 (got '$at_once')" >&2
+  exit 2
+fi
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 if [ "$#" -gt 0 ]; then targets=("$@"); else mapfile -t targets < "$build/tests/fuzz/targets.txt"; fi
 artifacts="$build/fuzz-artifacts"
@@ -56,7 +61,6 @@ fuzz_one() {  # target: fuzzes it, then writes its one-line result to $scratch/<
     > "$scratch/$t.result"
 }
 
-at_once="${CLUMPKIT_FUZZ_JOBS:-$(nproc)}"
 for t in "${targets[@]}"; do
   while [ "$(jobs -rp | wc -l)" -ge "$at_once" ]; do wait -n; done
   fuzz_one "$t" &
