@@ -242,6 +242,54 @@ TEST(World, FactoryMixtureByMassAndRate) {
   EXPECT_GT(w.kinetic_energy(), 0.0);
 }
 
+// end_below: a factory whose region is nearly full ends at the first batch that places less
+// than that fraction of its share, instead of trickling on until a batch places nothing. Until
+// then it is the same pour, bit for bit.
+TEST(World, FactoryEndsWhenItOnlyTrickles) {
+  auto make = [](double end_below) {
+    WorldSettings s = pour(1);
+    FactorySettings& f = s.factories[0];
+    f.region =
+        BoxRegion{Eigen::Vector3d(-0.011, -0.011, 0.0), Eigen::Vector3d(0.011, 0.011, 0.014)};
+    f.count = 100000;  // far more than the region holds
+    f.rate = 1000.0;   // clumps/s: 20 due per 20 ms batch
+    f.interval = 0.02;
+    f.fail_if_behind = false;
+    f.end_below = end_below;
+    return World::create(s);
+  };
+  World trickle = make(0.0), cut = make(0.5);
+  std::vector<long> per_batch;  // clumps the cut factory placed in each batch
+  long before = 0;
+  for (int k = 1; k <= 40 && !cut.factories_done(); ++k) {
+    cut.run_until(0.02 * k - 1e-4);  // the batch of t = 0.02 (k - 1) s is in
+    trickle.run_until(0.02 * k - 1e-4);
+    per_batch.push_back(cut.factory_status(0).inserted - before);
+    before = cut.factory_status(0).inserted;
+    ASSERT_EQ(cut.state_hash(), trickle.state_hash()) << "batch " << k;
+  }
+  ASSERT_TRUE(cut.factories_done()) << "the region never filled";
+  ASSERT_GE(per_batch.size(), 3u);
+  EXPECT_EQ(per_batch.front(), 20);                  // an empty region takes the whole share
+  EXPECT_LT(per_batch.back(), 10);                   // the batch that ended it trickled
+  for (size_t k = 0; k + 1 < per_batch.size(); ++k)  // and none before it did
+    EXPECT_GE(per_batch[k], 10) << "batch " << k;
+  // Without end_below the same pour goes on placing pills into the gaps.
+  EXPECT_FALSE(trickle.factories_done());
+  trickle.run_until(cut.time() + 0.2);
+  EXPECT_GT(trickle.factory_status(0).inserted, cut.factory_status(0).inserted);
+  // A fraction outside [0, 1] names the field.
+  WorldSettings bad = pour(1);
+  bad.source = "scene.toml";
+  bad.factories[0].end_below = 1.5;
+  try {
+    (void)World::create(bad);
+    FAIL() << "end_below 1.5 accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "factories[0].end_below");
+  }
+}
+
 // A second pour added while running (World::add_factory, the angle-of-repose rig's top-up once
 // its tube is full) is the same as a World created with it in its settings: same state, and the
 // checkpoints taken after the call load into such a World and run on bit-identically.

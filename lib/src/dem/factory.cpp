@@ -122,6 +122,7 @@ void World::Impl::run_factories() {
     const double target = by_count ? static_cast<double>(*f.s.count) : *f.s.mass;
     due = at_once ? target : std::min(target, f.s.rate * f.interval * (f.batch + 1));
     ++f.batch;
+    const double had = by_count ? static_cast<double>(f.status.inserted) : f.status.inserted_mass;
 
     // Overlap grid: existing spheres near the region, plus wall triangles near it.
     Eigen::AlignedBox3d box;
@@ -229,6 +230,10 @@ void World::Impl::run_factories() {
     // A factory allowed to fall behind whose region is blocked (nothing fitted in this batch,
     // e.g. the heap has grown into it) is finished: waiting would never end.
     if (stuck && !f.s.fail_if_behind && placed == 0) f.status.done = true;
+    // ... and so is one whose blocked region only trickles (end_below).
+    if (stuck && !f.s.fail_if_behind && !at_once &&
+        have - had < f.s.end_below * f.s.rate * f.interval)
+      f.status.done = true;
     if ((reached && due >= target) || at_once) f.status.done = true;
   }
 }

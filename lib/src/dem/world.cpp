@@ -85,6 +85,8 @@ FactoryRuntime make_factory(const World::Impl& w, const WorldSettings& s, const 
     throw InputError(where, f + ".rate", "must be >= 0");
   if (!(fs.interval >= 0.0)) throw InputError(where, f + ".interval", "must be >= 0 s");
   if (fs.attempts_per_clump < 1) throw InputError(where, f + ".attempts_per_clump", "must be >= 1");
+  if (!(fs.end_below >= 0.0 && fs.end_below <= 1.0))
+    throw InputError(where, f + ".end_below", "must be in [0, 1] (a fraction of one batch)");
   if (fs.mixture.empty()) throw InputError(where, f + ".mixture", "no clump types given");
   double total = 0.0;
   for (size_t e = 0; e < fs.mixture.size(); ++e) {

@@ -153,7 +153,7 @@ double cull(Ctx& c, dem::World& w) {
 // (constant-torque rolling friction can keep a few pills creeping: the bed counts as settled
 // then, and the details say so).
 SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
-                  const std::string& what) {
+                  const std::string& what, const std::function<bool()>& stop) {
   SettleInfo s;
   double t_begin = w.time();
   double t_factories = w.factories_done() ? w.time() : -1.0;
@@ -178,6 +178,10 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
     cull(c, w);
     if (t_factories < 0 && w.factories_done()) t_factories = w.time();
     s.rms_speed = rms_speed(w);
+    if (t_factories >= 0 && stop && stop()) {
+      s.stopped = true;
+      break;
+    }
     quiet = (t_factories >= 0 && s.rms_speed < c.p.settle_speed) ? quiet + 1 : 0;
     c.progress([&] {
       return fmt::format("{}: t = {:.3f} s, {} clumps, rms speed {:.4f} m/s", what, w.time(),
@@ -273,8 +277,13 @@ dem::World open_world(Ctx& c, const dem::WorldSettings& ws, const nlohmann::json
 
 // Phase 1: pour and settle.
 SettleInfo pour_and_settle(Ctx& c, dem::World& w, const std::string& what,
-                           const nlohmann::json& extra) {
-  SettleInfo info = settle(c, w, 1, extra, what);
+                           const nlohmann::json& extra, const std::function<bool()>& stop) {
+  SettleInfo info = settle(c, w, 1, extra, what, stop);
+  if (info.stopped) {
+    c.say(fmt::format("{}: poured by {:.3f} s, {} clumps, rms speed {:.4f} m/s", what, w.time(),
+                      w.clump_count(), info.rms_speed));
+    return info;
+  }
   c.say(fmt::format("{}: {} after {:.3f} s, {} clumps, rms speed {:.4f} m/s", what,
                     info.settled ? "settled" : "settle time cap reached", w.time(), w.clump_count(),
                     info.rms_speed));

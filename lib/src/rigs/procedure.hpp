@@ -103,14 +103,17 @@ struct SettleInfo {
   bool settled = false;
   double time = 0.0;     // s simulated in this settle
   double rms_speed = 0;  // m/s at the end
+  bool stopped = false;  // ended by `stop` (the factories done, the bed not yet at rest)
 };
 
 /// Runs until the factories are done and the RMS clump speed stays below the scale's threshold
 /// for 3 checks 10 ms apart, or until settle_max of simulated time after the factories finished
 /// (constant-torque rolling friction can keep a few pills creeping: the bed counts as settled
 /// then, and the details say so). Resumes its own bookkeeping from a checkpoint taken inside it.
+/// `stop`, if given, is asked at each check once the factories are done: true ends the settle
+/// there (SettleInfo::stopped; the next pour need not wait for this bed to come to rest).
 SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
-                  const std::string& what);
+                  const std::string& what, const std::function<bool()>& stop = {});
 nlohmann::json settle_json(const SettleInfo& s);
 /// The World's spheres (positions and radii).
 Spheres world_spheres(const dem::World& w);
@@ -126,7 +129,8 @@ dem::World open_world(Ctx& c, const dem::WorldSettings& ws, const nlohmann::json
                       const std::string& what);
 /// Phase 1: pour and settle.
 SettleInfo pour_and_settle(Ctx& c, dem::World& w, const std::string& what,
-                           const nlohmann::json& extra = {});
+                           const nlohmann::json& extra = {},
+                           const std::function<bool()>& stop = {});
 /// Phase 2 begins: the action's wall starts moving in the same World (contact histories kept).
 void start_action(Ctx& c, dem::World& w, int wall, const dem::WallMotion& m, nlohmann::json& state);
 

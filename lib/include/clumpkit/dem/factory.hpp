@@ -55,6 +55,11 @@ struct FactorySettings {
   /// as fast as the region allows, carrying the deficit (the rigs: they need the mass, not the
   /// rate). Such a factory ends when a whole batch fits nothing (its region is blocked).
   bool fail_if_behind = true;
+  /// With a rate and fail_if_behind = false, the factory also ends after a batch that could not
+  /// place all it was due and placed less than this fraction of one batch at the rate (rate ×
+  /// interval): its region is nearly full and only trickles (the rigs' column fill hands the
+  /// rest to the pour from above). 0 = end only when a batch places nothing.
+  double end_below = 0.0;
 };
 
 /// What a factory has done so far.

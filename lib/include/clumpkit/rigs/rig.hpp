@@ -22,8 +22,10 @@ namespace clumpkit::rigs {
 
 /// Changes whenever a rig gives different results for the same model, settings, scale and seed
 /// (caches of rig results key on it, beside dem::kPhysicsRevision): 1 = session 30's 24 mm
-/// wheel slice at `tiny` (12 mm arched above the throat).
-inline constexpr int kRigsRevision = 1;
+/// wheel slice at `tiny` (12 mm arched above the throat); 2 = session 31's angle-of-repose fill
+/// when the tube cannot hold the mass (paper scale): the column fill ends once it trickles and
+/// the pour from above follows at once.
+inline constexpr int kRigsRevision = 2;
 
 /// Numbers that size a rig at one scale. Defaults are filled by rig_scale(); every field is
 /// reported in the result's JSON so a run documents itself.
