@@ -105,7 +105,7 @@ RepeatResult angle_of_repose(Ctx& c) {
       };
       s1 = pour_and_settle(c, w, "fill", {}, short_of_mass);
       const double in_tube = w.factory_status(0).inserted_mass;
-      if (p.heap_mass - in_tube > 0.5 * mean_pill_mass(w)) {
+      if (short_of_mass()) {
         state = {{"top_up", {{"t", w.time()}, {"kg", p.heap_mass - in_tube}}}};
         w.add_factory(top_up(w.time(), p.heap_mass - in_tube));
         c.say(
