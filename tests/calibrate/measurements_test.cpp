@@ -37,6 +37,27 @@ TEST(Measurements, ReadsTheSpecFormat) {
   EXPECT_EQ(m[3].n, 3);
 }
 
+// A spreadsheet's spellings of the units: converted to the canonical unit like any other.
+TEST(Measurements, SpreadsheetUnitSpellings) {
+  const auto m =
+      parse_measurements(kHeader +
+                             "bulk_density,A,,bulk_density,712.4,6.1,3,g/L\n"
+                             "angle_of_repose,mix,plate=galvanized_steel,angle,27.3,0.8,3,\u00b0\n"
+                             "discharge,mix,rpm=15,mass_flow,1260,36,3,kg/h\n"
+                             "discharge,mix,rpm=30,pocket_mass_cv,4,1,3,%\n",
+                         "m.csv");
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_DOUBLE_EQ(m[0].value, 712.4);
+  EXPECT_EQ(m[0].unit, "kg/m^3");
+  EXPECT_DOUBLE_EQ(m[1].value, 27.3);
+  EXPECT_EQ(m[1].unit, "deg");
+  EXPECT_NEAR(m[2].value, 0.35, 1e-15);
+  EXPECT_NEAR(m[2].std, 0.01, 1e-15);
+  EXPECT_EQ(m[2].unit, "kg/s");
+  EXPECT_NEAR(m[3].value, 0.04, 1e-15);
+  EXPECT_NEAR(m[3].std, 0.01, 1e-15);
+}
+
 TEST(Measurements, ColumnsInAnyOrderAndExtraColumns) {
   const auto m = parse_measurements(
       "note,unit,n,std,value,quantity,setting,sample,rig\n"
@@ -87,6 +108,15 @@ TEST(Measurements, BadLinesAreNamed) {
     EXPECT_NE(std::string(e.what()).find("h.csv:1: setting: missing column"), std::string::npos);
   }
   EXPECT_THROW(parse_measurements("", "e.csv"), InputError);
+  // A semicolon-separated export is named as such, not as a missing column.
+  try {
+    parse_measurements("rig;sample;setting;quantity;value;std;n;unit\n", "s.csv");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.csv:1: the header is separated by ';'"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Measurements, FormatRoundTrips) {

@@ -21,6 +21,36 @@ TEST(Units, ConvertsToSI) {
   EXPECT_DOUBLE_EQ(parse_quantity("0.35", Dimension::Dimensionless), 0.35);
 }
 
+// The spellings of a lab spreadsheet: superscripts, the degree sign, micro, litres, per hour.
+TEST(Units, SpreadsheetSpellingsAreTheSameUnits) {
+  const double deg = M_PI / 180.0;
+  EXPECT_DOUBLE_EQ(parse_quantity("31.5°", Dimension::Angle), 31.5 * deg);
+  EXPECT_DOUBLE_EQ(parse_quantity("31.5 °", Dimension::Angle), 31.5 * deg);
+  EXPECT_DOUBLE_EQ(parse_quantity("31.5 degrees", Dimension::Angle), 31.5 * deg);
+  EXPECT_DOUBLE_EQ(parse_quantity("1 degree", Dimension::Angle), deg);
+  EXPECT_DOUBLE_EQ(parse_quantity("735 kg/m³", Dimension::Density), 735.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("735 g/L", Dimension::Density), 735.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.735 g/mL", Dimension::Density), 735.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.735 kg/L", Dimension::Density), 735.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.735 g/cm³", Dimension::Density), 735.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("6000 J/m³", Dimension::Pressure), 6000.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("250 µm", Dimension::Length), 250e-6);  // micro sign
+  EXPECT_DOUBLE_EQ(parse_quantity("250 μm", Dimension::Length), 250e-6);  // Greek mu
+  EXPECT_DOUBLE_EQ(parse_quantity("5 µs", Dimension::Time), 5e-6);
+  EXPECT_DOUBLE_EQ(parse_quantity("2 h", Dimension::Time), 7200.0);
+  EXPECT_DOUBLE_EQ(parse_quantity("260 ml", Dimension::Volume), 2.6e-4);
+  EXPECT_DOUBLE_EQ(parse_quantity("260000 mm³", Dimension::Volume), 2.6e-4);
+  EXPECT_DOUBLE_EQ(parse_quantity("9.81 m/s²", Dimension::Acceleration), 9.81);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.05 J/m²", Dimension::SurfaceEnergy), 0.05);
+  EXPECT_DOUBLE_EQ(parse_quantity("21 kg/min", Dimension::MassFlow), 0.35);
+  EXPECT_DOUBLE_EQ(parse_quantity("1260 kg/h", Dimension::MassFlow), 0.35);
+  EXPECT_DOUBLE_EQ(parse_quantity("1.26 t/h", Dimension::MassFlow), 0.35);
+  EXPECT_DOUBLE_EQ(parse_quantity("21000 g/min", Dimension::MassFlow), 0.35);
+  // Still one dimension each: a degree is no density, an hour no length.
+  EXPECT_THROW(parse_quantity("30 °", Dimension::Density), InputError);
+  EXPECT_THROW(parse_quantity("2 h", Dimension::Length), InputError);
+}
+
 TEST(Units, RejectsWithFieldNamed) {
   struct Case {
     const char* text;

@@ -91,6 +91,11 @@ std::vector<Measurement> parse_measurements(const std::string& text, const std::
         if (col.count(cells[i])) throw InputError(where, cells[i], "column given twice");
         col[cells[i]] = i;
       }
+      // A European spreadsheet's export separates with semicolons (decimal commas inside).
+      if (cells.size() == 1 && cells[0].find(';') != std::string::npos)
+        throw InputError(where, "",
+                         "the header is separated by ';', not ',' (export the sheet as "
+                         "comma-separated values with decimal points)");
       for (const char* r : required)
         if (!col.count(r))
           throw InputError(where, r,
