@@ -86,8 +86,10 @@ const std::vector<RigInfo>& rig_catalogue() {
                   {"slice",
                    {},
                    "mm",
-                   "100",
-                   "length of the wheel slice along its axis (scale default; paper 100 mm)"},
+                   "20",
+                   "length of the wheel slice along its axis (scale default: 24 mm at tiny "
+                   "and mini, 20 mm at small and paper; the paper's pocket is 100 mm, and at "
+                   "paper scale the bed is 10 kg per 100 mm of slice)"},
                   {"pockets", {}, "1", "8", "pockets measured after the first (scale default)"},
                   stiffness,
                   damping}});

@@ -80,6 +80,16 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
     // default `all_in no`) the region delivers the 0.04 kg/s asked (docs/rigs.md).
     p.pour_whole_in_region = false;
     p.settle_max = 5.0;
+    if (rig == "discharge") {
+      // The documented reduction (SPEC §7): a periodic slice of the wheel along its axis
+      // (small's 20 mm, so small and paper differ only in stiffness and bed depth) holding the
+      // paper's 10 kg per 100 mm of pocket (kPaperBedPerLength below), i.e. the hopper filled to
+      // the paper's height. The full 100 mm, 10 kg ≈ 60 000 pills, is `--set slice=100`. The
+      // hopper is filled at 1 kg/s per 20 mm (the paper does not say how fast it was filled;
+      // the D 20 mm rate above would take 50 s of simulated time for 2 kg).
+      p.slice_length = 0.020;
+      p.pour_rate = 1.0;
+    }
   }
   auto num = [&](const char* k) -> std::optional<double> {
     const auto f = settings.find(k);
@@ -98,6 +108,10 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
   if (auto v = num("mass")) p.heap_mass = *v;
   if (auto v = num("rpm")) p.rpm = *v;
   if (auto v = num("slice")) p.slice_length = *v * 1e-3;
+  if (p.name == "paper" && rig == "discharge") {
+    p.bed_mass = kPaperBedPerLength * p.slice_length;
+    p.pour_rate *= p.slice_length / 0.020;
+  }
   if (auto v = num("pockets")) {
     if (*v != std::floor(*v) || *v < 2 || *v > 100)
       throw InputError("--set", "pockets", "must be a whole number in [2, 100]");

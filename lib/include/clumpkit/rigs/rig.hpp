@@ -24,8 +24,12 @@ namespace clumpkit::rigs {
 /// (caches of rig results key on it, beside dem::kPhysicsRevision): 1 = session 30's 24 mm
 /// wheel slice at `tiny` (12 mm arched above the throat); 2 = session 31's angle-of-repose fill
 /// when the tube cannot hold the mass (paper scale): the column fill ends once it trickles and
-/// the pour from above follows at once.
-inline constexpr int kRigsRevision = 2;
+/// the pour from above follows at once; 3 = session 33's paper-scale discharge: a 20 mm slice
+/// holding 10 kg per 100 mm, its hopper filled at 1 kg/s per 20 mm (was 100 mm, 10 kg, 0.04 kg/s).
+inline constexpr int kRigsRevision = 3;
+/// The paper's discharger bed per length of pocket (10 kg in the 100 mm pocket, SPEC §7), kg/m:
+/// at paper scale a slice of the wheel holds this times its length.
+inline constexpr double kPaperBedPerLength = 100.0;
 
 /// Numbers that size a rig at one scale. Defaults are filled by rig_scale(); every field is
 /// reported in the result's JSON so a run documents itself.
