@@ -25,14 +25,16 @@ fs::path temp_dir(const std::string& name) {
 std::string error_of(const std::string& scene_text) {
   const fs::path d = temp_dir("err");
   write_file_atomic(d / "s.toml", scene_text);
+  std::string message;
   try {
     sim::Scene s = sim::load_scene(d / "s.toml", kData);
     auto w = dem::World::create(s.world);
     (void)w;
   } catch (const InputError& e) {
-    return e.what();
+    message = e.what();
   }
-  return "";
+  fs::remove_all(d);
+  return message;
 }
 
 const std::string kBase = R"(
