@@ -81,8 +81,8 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
     p.pour_whole_in_region = false;
     p.settle_max = 5.0;
     if (rig == "discharge") {
-      // The documented reduction (SPEC §7): a periodic slice of the wheel along its axis
-      // (small's 20 mm, so small and paper differ only in stiffness and bed depth) holding the
+      // The documented reduction (SPEC §7): a slice of the wheel along its axis, closed by end
+      // plates (small's 20 mm, so small and paper share the slice's geometry), holding the
       // paper's 10 kg per 100 mm of pocket (kPaperBedPerLength below), i.e. the hopper filled to
       // the paper's height. The full 100 mm, 10 kg ≈ 60 000 pills, is `--set slice=100`. The
       // hopper is filled at 1 kg/s per 20 mm (the paper does not say how fast it was filled;
