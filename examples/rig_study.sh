@@ -45,12 +45,21 @@ pool() {
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
   run "$@" &
 }
+# The discharger as the paper ran it: one bed per repeat, filled once (at 10 rpm's run) and
+# turned at 15 and 30 rpm too (--bed-from; the same bits as filling it again, docs/rigs.md).
+dis10=""
+if want discharge; then pool dis_10 discharge --model production --set rpm=10; dis10=$!; fi
 for m in paper_A4 paper_A12 paper_A20 paper_B4 paper_B12 paper_B20 paper_C2 paper_C12 paper_C18; do
   if want bulk_density; then pool "bd_$m" bulk_density --model "$m"; fi
   if want angle_of_repose; then pool "aor_$m" angle_of_repose --model "$m"; fi
 done
-for rpm in 10 15 30; do
-  if want discharge; then pool "dis_$rpm" discharge --model production --set "rpm=$rpm"; fi
-done
+if want discharge; then
+  [ -n "$dis10" ] && { wait "$dis10" || true; }
+  bed=()  # a study folder from before session 33 has no beds: then each speed fills its own
+  [ -f "$out/dis_10/repeat_1/bed/bed.json" ] && bed=(--bed-from "$out/dis_10")
+  for rpm in 15 30; do
+    pool "dis_$rpm" discharge --model production --set "rpm=$rpm" "${bed[@]}"
+  done
+fi
 wait
 python3 "$(dirname "$0")/rig_study_table.py" "$out"

@@ -26,7 +26,26 @@ struct RigArgs {
   int threads = 0;
   long rays = 20000;
   double checkpoint_interval = 60.0;
+  std::string bed_from;
 };
+
+// --bed-from: only for the discharge rig, a folder holding every repeat's bed (whether a bed fits
+// this run's model, scale and seed is checked as each repeat takes it).
+fs::path checked_bed_from(const RigArgs& a, const RigInfo& info) {
+  if (a.bed_from.empty()) return {};
+  if (info.name != "discharge")
+    throw InputError("--bed-from", a.bed_from, "only the discharge rig turns a saved bed");
+  if (!fs::is_directory(a.bed_from)) throw InputError("--bed-from", a.bed_from, "is not a folder");
+  for (int k = 1; k <= a.repeats; ++k) {
+    const fs::path meta = fs::path(a.bed_from) / fmt::format("repeat_{}", k) / "bed" / "bed.json";
+    if (!fs::exists(meta))
+      throw InputError("--bed-from", a.bed_from,
+                       fmt::format("no bed for repeat {} ({} is missing: the run that made it "
+                                   "must have finished its fill, with --out)",
+                                   k, meta.string()));
+  }
+  return a.bed_from;
+}
 
 void list_rigs() {
   for (const auto& r : rig_catalogue()) {
@@ -81,6 +100,10 @@ Command setup_rig(CLI::App& parent) {
                 "last one)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  c->add_option("--bed-from", a->bed_from,
+                "discharge: turn the beds of an earlier run (its --out folder) at this run's "
+                "rpm instead of filling the hopper again, as the paper turned one bed at 10, 15 "
+                "and 30 rpm (same model, scale, seeds; the earlier run needs --out)");
   c->add_flag("--list", a->list, "List the rigs, their quantities, settings and the effects");
   c->add_option("--write-meshes", a->meshes,
                 "Write the rigs' wall meshes (paper size, STL in metres) to this folder and exit");
@@ -117,6 +140,7 @@ Command setup_rig(CLI::App& parent) {
             req.threads = a->threads;
             req.rays = a->rays;
             req.checkpoint_interval = a->checkpoint_interval;
+            req.bed_from = checked_bed_from(*a, info);
             if (a->vtk && a->out.empty())
               throw InputError("--vtk", "", "VTK output needs --out DIR");
             if (!a->out.empty()) {

@@ -160,6 +160,32 @@ TEST(RigEndToEnd, DischargeFillsThePockets) {
   const auto& d = r.repeats[0].details;
   EXPECT_LT(d.at("pinched").at("kg").get<double>(),
             0.5 * d.at("pocket_mass_slice_kg").get<double>());
+  // The bed (the hopper filled and at rest) is kept, and a second run turns it instead of
+  // filling its own. At the same speed it gives the first run's bits: the checkpoint holds the
+  // whole state. (At another speed it gives a fresh run's bits at that speed, since the fill does
+  // not depend on the speed: checked by hand at 15 rpm, docs/rigs.md.)
+  EXPECT_TRUE(fs::exists(q.out / "repeat_1" / "bed" / "bed.ckpt"));
+  EXPECT_GT(d.at("bed").at("at_rest_kg").get<double>(), 0.0);
+  RigRequest again = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge_bed");
+  again.bed_from = q.out;
+  const RigResult b = run_rig(again);
+  ASSERT_TRUE(b.error.empty()) << b.error;
+  EXPECT_EQ(b.repeats[0].values, r.repeats[0].values);
+  const auto& db = b.repeats[0].details;
+  EXPECT_NE(db.at("bed_from").get<std::string>(), "");
+  EXPECT_EQ(db.at("bed"), d.at("bed"));
+  EXPECT_EQ(db.at("simulated_time_s"), d.at("simulated_time_s"));
+  EXPECT_LT(db.at("profile").at("steps").get<long>(), d.at("profile").at("steps").get<long>());
+  // Another seed's bed is not this one: refused, naming the bed's record.
+  RigRequest other = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge_bed2");
+  other.seed = 2;
+  other.bed_from = q.out;
+  try {
+    run_rig(other);
+    ADD_FAILURE() << "a bed of seed 1 was turned for seed 2";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bed.json"), std::string::npos) << e.what();
+  }
 }
 
 TEST(RigEndToEnd, ScaleThatCannotHoldTheMassIsRefused) {

@@ -98,55 +98,6 @@ std::map<std::string, SimulatedValue> simulate_measurements(Simulator& sim,
   return out;
 }
 
-std::string model_fingerprint(const ParticleModel& m) {
-  std::ostringstream s;
-  s.precision(17);
-  s << "basis " << to_string(m.mass_basis) << "\n";
-  for (const auto& name : m.materials.names()) {
-    const Material& mat = m.materials.get(name);
-    s << "mat " << name << " " << mat.density << " " << mat.poisson_ratio << " "
-      << mat.youngs_modulus << "\n";
-    for (const auto& other : m.materials.names())
-      if (m.materials.has_interaction(name, other)) {
-        const Interaction& i = m.materials.interaction(name, other);
-        s << "int " << name << " " << other << " " << i.restitution << " " << i.static_friction
-          << " " << i.rolling_friction << "\n";
-      }
-  }
-  for (const auto& t : m.types) {
-    s << "type " << t.name << " " << t.shape.diameter << " " << t.shape.height << " "
-      << t.shape.density << " " << t.mass_fraction << " " << t.paper_spheres.value_or(0) << " "
-      << t.given_mass.value_or(0.0) << " ";
-    if (!t.clump_path.empty())
-      s << read_file(t.clump_path).size() << ":"
-        << std::hash<std::string>{}(read_file(t.clump_path));
-    s << "\n";
-  }
-  const ModelEffects& e = m.effects;
-  auto partners = [&](const char* n, const std::optional<std::map<std::string, double>>& v) {
-    s << n;
-    if (v)
-      for (const auto& [k, x] : *v) s << " " << k << "=" << x;
-    else
-      s << " absent";
-    s << "\n";
-  };
-  partners("rolling_friction", e.rolling_friction);
-  partners("wall_friction", e.wall_friction);
-  partners("restitution", e.restitution);
-  s << "particle_friction "
-    << (e.particle_friction ? fmt::format("{:.17g}", *e.particle_friction) : "absent") << "\n";
-  s << "cohesion " << (e.cohesion ? fmt::format("{:.17g}", *e.cohesion) : "absent") << "\n";
-  s << "shape_resolution " << e.shape_resolution.value_or(0) << "\n";
-  // One type without a height spread is one size whether the effect is listed or not.
-  s << "size_distribution " << (e.size_distribution && (m.types.size() > 1 || e.height_spread > 0));
-  if (e.size_distribution && e.height_spread > 0) s << fmt::format(" {:.17g}", e.height_spread);
-  s << "\n";
-  s << "rolling_model " << (e.rolling_model ? dem::to_string(*e.rolling_model) : "default") << " "
-    << e.epsd_damping << "\n";
-  return s.str();
-}
-
 RigSimulator::RigSimulator(Options options) : opt_(std::move(options)) {}
 
 RigSimulator::Entry RigSimulator::entry(const ParticleModel& model, const SimRequest& req,

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/dem/world.hpp"
 #include "clumpkit/rigs/geometry.hpp"
@@ -17,6 +18,65 @@
 namespace clumpkit::rigs::detail {
 
 using Eigen::Vector3d;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Everything that makes a repeat's bed (the hopper filled and at rest, before the wheel turns):
+// the model, the scale's parameters but the wheel's speed and the pockets counted, the seed,
+// the rays of the clumps' mass properties and the code's revisions.
+std::string bed_fingerprint(const Ctx& c) {
+  const ScaleParams& p = c.p;
+  return fmt::format(
+      "{}|seed {}|rays {}|scale {} stiffness {:.17g} implicit {} rayleigh {:.17g} settle {:.17g} "
+      "{:.17g} pour {:.17g} {} wheel {:.17g} slice {:.17g} bed {:.17g}|engine {} rigs {}",
+      model_fingerprint(c.req.model), c.seed, c.req.rays, p.name, p.stiffness_scale,
+      p.implicit_damping, p.rayleigh_fraction, p.settle_speed, p.settle_max, p.pour_rate,
+      p.pour_whole_in_region, p.wheel_scale, p.slice_length, p.bed_mass, dem::kPhysicsRevision,
+      kRigsRevision);
+}
+
+// The bed is kept in the repeat's folder, bed/ (apart from the running checkpoints, which are
+// pruned): bed.ckpt, then bed.json (its state and fingerprint), which marks it complete.
+void save_bed(const Ctx& c, const dem::World& w, const nlohmann::json& state) {
+  if (c.dir.empty()) return;
+  const fs::path d = c.dir / "bed";
+  fs::create_directories(d);
+  w.save_checkpoint(d / "bed.ckpt");
+  write_file_atomic(d / "bed.json",
+                    nlohmann::json{{"state", state}, {"fingerprint", bed_fingerprint(c)}}.dump(2));
+}
+
+// Loads the bed of this repeat from req.bed_from into `w` and returns its state.
+nlohmann::json take_bed(Ctx& c, dem::World& w) {
+  const fs::path d = c.req.bed_from / fmt::format("repeat_{}", c.repeat + 1) / "bed";
+  const fs::path meta = d / "bed.json";
+  if (!path_exists(meta) || !path_exists(d / "bed.ckpt"))
+    throw InputError("--bed-from", c.req.bed_from.string(),
+                     fmt::format("no bed for repeat {} ({} is missing: the run that made it must "
+                                 "have finished its fill, with --out)",
+                                 c.repeat + 1, meta.string()));
+  nlohmann::json saved;
+  try {
+    saved = nlohmann::json::parse(read_file(meta));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(meta.string(), "", std::string("not a bed record: ") + e.what());
+  }
+  if (!saved.contains("state") || saved.value("fingerprint", "") != bed_fingerprint(c))
+    throw InputError(meta.string(), "fingerprint",
+                     fmt::format("the bed was made by another model, scale, seed or version (this "
+                                 "repeat: seed {}, scale {}); only the wheel's speed (rpm) and "
+                                 "the pockets counted may differ",
+                                 c.seed, c.p.name));
+  w.load_checkpoint(d / "bed.ckpt");
+  c.say(fmt::format("bed taken from {} (t = {:.3f} s, {} clumps)", d.string(), w.time(),
+                    w.clump_count()));
+  nlohmann::json state = saved.at("state");
+  state["bed_from"] = d.string();
+  return state;
+}
+
+}  // namespace
 
 RepeatResult discharge(Ctx& c) {
   const ScaleParams& p = c.p;
@@ -81,23 +141,33 @@ RepeatResult discharge(Ctx& c) {
   c.outside = [z_out](const Vector3d& x) { return x.z() < z_out; };
 
   nlohmann::json state = load_state(c);
+  const int phase = state.value("phase", 0);
+  if (phase == 1 && !c.req.bed_from.empty())
+    throw InputError("--bed-from", c.req.bed_from.string(),
+                     fmt::format("{} holds a fill in progress of its own: resume it without "
+                                 "--bed-from, or give another --out",
+                                 c.dir.string()));
   dem::World w = open_world(c, ws, state, "fill hopper");
-  if (state.value("phase", 0) < 2) {
-    const SettleInfo s1 = pour_and_settle(c, w, "fill hopper");
-    snapshot(c, w, "bed");
-    const double t_on = w.time() + 0.01;
-    // Pills that leaked through the outlet while the wheel stood still are not counted.
-    state = {{"t_action", t_on},
-             {"fill_time_s", w.time()},
-             {"settle_fill", settle_json(s1)},
-             {"bed",
-              {{"asked_kg", p.bed_mass},
-               {"poured_kg", w.factory_status(0).inserted_mass},
-               {"at_rest_kg", w.total_mass()}}},
-             {"leaked_kg", c.removed_mass}};
+  if (phase < 2) {
+    if (!c.req.bed_from.empty()) {
+      state = take_bed(c, w);
+    } else {
+      const SettleInfo s1 = pour_and_settle(c, w, "fill hopper");
+      snapshot(c, w, "bed");
+      // Pills that leaked through the outlet while the wheel stood still are not counted.
+      state = {{"t_action", w.time() + 0.01},
+               {"fill_time_s", w.time()},
+               {"settle_fill", settle_json(s1)},
+               {"bed",
+                {{"asked_kg", p.bed_mass},
+                 {"poured_kg", w.factory_status(0).inserted_mass},
+                 {"at_rest_kg", w.total_mass()}}},
+               {"leaked_kg", c.removed_mass}};
+      save_bed(c, w, state);
+    }
     c.removed_mass = 0.0;
     state["removed_kg"] = 0.0;
-    start_action(c, w, wheel_wall, wheel(t_on).motion, state);
+    start_action(c, w, wheel_wall, wheel(state.at("t_action").get<double>()).motion, state);
   }
   const double t0 = state.at("t_action");
   c.removed_mass = state.value("removed_kg", 0.0);
@@ -200,6 +270,7 @@ RepeatResult discharge(Ctx& c) {
                {"curve_mass_kg", curve_m},
                {"settle_fill", state["settle_fill"]},
                {"bed", state.value("bed", nlohmann::json::object())},
+               {"bed_from", state.value("bed_from", "")},
                {"leaked_before_start_kg", state.value("leaked_kg", 0.0)},
                {"pills", w.clump_count()},
                {"simulated_time_s", w.time()},

@@ -70,9 +70,6 @@ std::map<std::string, SimulatedValue> simulate_measurements(
     Simulator& sim, const ParticleModel& model, const std::vector<Measurement>& measurements,
     const std::string& scale, int repeats, std::uint64_t seed);
 
-/// A stable text of everything in a model that changes the physics (for cache keys).
-std::string model_fingerprint(const ParticleModel& model);
-
 /// The real rigs, with an on-disk cache (one JSON per run, written atomically).
 class RigSimulator final : public Simulator {
  public:

@@ -106,6 +106,10 @@ ParticleModel load_model(const std::filesystem::path& path,
 ParticleModel parse_model(const std::string& text, const std::filesystem::path& path,
                           const std::filesystem::path& data_dir = {});
 
+/// A stable text of everything in a model that changes the physics (for cache keys and for
+/// matching a rig's saved bed to the model that made it).
+std::string model_fingerprint(const ParticleModel& model);
+
 /// Replaces an effect from a `--set`-style assignment "effects.rolling_friction.pill=0.1" or
 /// "effects.cohesion=off". Throws InputError naming `where` for unknown effects or bad values.
 void set_model_effect(ParticleModel& model, const std::string& key, const std::string& value,

@@ -77,6 +77,12 @@ struct RigRequest {
   int threads = 0;                    ///< 0 = all
   long rays = 20000;                  ///< ray sampling of the clumps' mass properties
   double checkpoint_interval = 60.0;  ///< s of wall-clock time between checkpoints
+  /// discharge only: an earlier run's `out` folder whose beds (each repeat's hopper, filled and at
+  /// rest, saved in repeat_K/bed/) this run turns at its own speed instead of pouring its own:
+  /// the paper's procedure, one bed turned at 10, 15 and 30 rpm. The model, scale (but the
+  /// wheel's speed and the pockets counted), seed and rays must be the bed's (InputError
+  /// otherwise).
+  std::filesystem::path bed_from;
   std::function<void(const std::string&)> progress;  ///< one line per call, may be empty
   /// Edits the scale's parameters after the settings are applied (tests and studies that need
   /// a rig smaller than `mini`); recorded in the result like any other parameter.
