@@ -143,6 +143,7 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
   rr.threads = threads;
   rr.rays = opt_.rays;
   rr.out = e.run_dir;
+  rr.keep_bed = false;  // nothing turns a cached run's discharger bed again
   if (opt_.progress)
     rr.progress = [this](const std::string& s) {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -39,7 +39,7 @@ std::string bed_fingerprint(const Ctx& c) {
 // The bed is kept in the repeat's folder, bed/ (apart from the running checkpoints, which are
 // pruned): bed.ckpt, then bed.json (its state and fingerprint), which marks it complete.
 void save_bed(const Ctx& c, const dem::World& w, const nlohmann::json& state) {
-  if (c.dir.empty()) return;
+  if (c.dir.empty() || !c.req.keep_bed) return;
   const fs::path d = c.dir / "bed";
   fs::create_directories(d);
   w.save_checkpoint(d / "bed.ckpt");

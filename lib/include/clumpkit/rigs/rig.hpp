@@ -83,6 +83,9 @@ struct RigRequest {
   /// wheel's speed and the pockets counted), seed and rays must be the bed's (InputError
   /// otherwise).
   std::filesystem::path bed_from;
+  /// discharge only: keep each repeat's bed in `out` (repeat_K/bed/, the size of a checkpoint) for
+  /// a later run's bed_from. The calibration's rig runs do not (their cache would double).
+  bool keep_bed = true;
   std::function<void(const std::string&)> progress;  ///< one line per call, may be empty
   /// Edits the scale's parameters after the settings are applied (tests and studies that need
   /// a rig smaller than `mini`); recorded in the result like any other parameter.
