@@ -186,6 +186,18 @@ TEST(RigEndToEnd, DischargeFillsThePockets) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bed.json"), std::string::npos) << e.what();
   }
+  // A damaged record is named, not followed.
+  {
+    std::ofstream(q.out / "repeat_1" / "bed" / "bed.json") << R"({"state": {}, "fingerprint": 5})";
+  }
+  RigRequest damaged = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge_bed3");
+  damaged.bed_from = q.out;
+  try {
+    run_rig(damaged);
+    ADD_FAILURE() << "a damaged bed record was followed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a bed record"), std::string::npos) << e.what();
+  }
 }
 
 TEST(RigEndToEnd, ScaleThatCannotHoldTheMassIsRefused) {

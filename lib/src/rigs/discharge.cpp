@@ -56,13 +56,17 @@ nlohmann::json take_bed(Ctx& c, dem::World& w) {
                      fmt::format("no bed for repeat {} ({} is missing: the run that made it must "
                                  "have finished its fill, with --out)",
                                  c.repeat + 1, meta.string()));
-  nlohmann::json saved;
+  nlohmann::json state;
+  std::string fingerprint;
   try {
-    saved = nlohmann::json::parse(read_file(meta));
+    const nlohmann::json saved = nlohmann::json::parse(read_file(meta));
+    fingerprint = saved.at("fingerprint").get<std::string>();
+    state = saved.at("state");
+    (void)state.at("t_action").get<double>();
   } catch (const nlohmann::json::exception& e) {
     throw InputError(meta.string(), "", std::string("not a bed record: ") + e.what());
   }
-  if (!saved.contains("state") || saved.value("fingerprint", "") != bed_fingerprint(c))
+  if (fingerprint != bed_fingerprint(c))
     throw InputError(meta.string(), "fingerprint",
                      fmt::format("the bed was made by another model, scale, seed or version (this "
                                  "repeat: seed {}, scale {}); only the wheel's speed (rpm) and "
@@ -71,7 +75,6 @@ nlohmann::json take_bed(Ctx& c, dem::World& w) {
   w.load_checkpoint(d / "bed.ckpt");
   c.say(fmt::format("bed taken from {} (t = {:.3f} s, {} clumps)", d.string(), w.time(),
                     w.clump_count()));
-  nlohmann::json state = saved.at("state");
   state["bed_from"] = d.string();
   return state;
 }
