@@ -36,14 +36,7 @@ fs::path checked_bed_from(const RigArgs& a, const RigInfo& info) {
   if (info.name != "discharge")
     throw InputError("--bed-from", a.bed_from, "only the discharge rig turns a saved bed");
   if (!fs::is_directory(a.bed_from)) throw InputError("--bed-from", a.bed_from, "is not a folder");
-  for (int k = 1; k <= a.repeats; ++k) {
-    const fs::path meta = fs::path(a.bed_from) / fmt::format("repeat_{}", k) / "bed" / "bed.json";
-    if (!fs::exists(meta))
-      throw InputError("--bed-from", a.bed_from,
-                       fmt::format("no bed for repeat {} ({} is missing: the run that made it "
-                                   "must have finished its fill, with --out)",
-                                   k, meta.string()));
-  }
+  for (int k = 1; k <= a.repeats; ++k) rigs::require_bed(a.bed_from, k);
   return a.bed_from;
 }
 

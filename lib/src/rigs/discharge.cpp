@@ -49,13 +49,8 @@ void save_bed(const Ctx& c, const dem::World& w, const nlohmann::json& state) {
 
 // Loads the bed of this repeat from req.bed_from into `w` and returns its state.
 nlohmann::json take_bed(Ctx& c, dem::World& w) {
-  const fs::path d = c.req.bed_from / fmt::format("repeat_{}", c.repeat + 1) / "bed";
+  const fs::path d = require_bed(c.req.bed_from, c.repeat + 1);
   const fs::path meta = d / "bed.json";
-  if (!path_exists(meta) || !path_exists(d / "bed.ckpt"))
-    throw InputError("--bed-from", c.req.bed_from.string(),
-                     fmt::format("no bed for repeat {} ({} is missing: the run that made it must "
-                                 "have finished its fill, with --out)",
-                                 c.repeat + 1, meta.string()));
   nlohmann::json state;
   std::string fingerprint;
   try {
@@ -287,3 +282,18 @@ RepeatResult discharge(Ctx& c) {
 }
 
 }  // namespace clumpkit::rigs::detail
+
+namespace clumpkit::rigs {
+
+std::filesystem::path require_bed(const std::filesystem::path& run_out, int repeat) {
+  const std::filesystem::path d = run_out / fmt::format("repeat_{}", repeat) / "bed";
+  for (const char* f : {"bed.json", "bed.ckpt"})
+    if (!path_exists(d / f))
+      throw InputError("--bed-from", run_out.string(),
+                       fmt::format("no bed for repeat {} ({} is missing: the run that made it "
+                                   "must have finished its fill, with --out)",
+                                   repeat, (d / f).string()));
+  return d;
+}
+
+}  // namespace clumpkit::rigs

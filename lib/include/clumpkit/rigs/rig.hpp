@@ -62,6 +62,11 @@ struct ScaleParams {
   int pockets_measured = 8;
 };
 
+/// The folder holding repeat `repeat` (1-based) of a discharge run's bed under its `out`, after
+/// checking the bed is complete there (bed.json and bed.ckpt); InputError naming `--bed-from`
+/// otherwise.
+std::filesystem::path require_bed(const std::filesystem::path& run_out, int repeat);
+
 /// The scale's parameters for a rig with its (parsed) settings applied. Throws InputError for a
 /// setting the scale cannot honour.
 ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::string>& settings);
