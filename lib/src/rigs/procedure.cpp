@@ -168,6 +168,8 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
         t_begin = saved["settle"].at("t_begin");
         t_factories = saved["settle"].at("t_factories");
         quiet = saved["settle"].at("quiet");
+        // The mass culled so far in this phase (the discharger reports what leaked in its fill).
+        c.removed_mass = saved["settle"].value("removed_kg", c.removed_mass);
       }
     } catch (const nlohmann::json::exception&) {
     }
@@ -197,8 +199,11 @@ SettleInfo settle(Ctx& c, dem::World& w, int phase, const nlohmann::json& extra,
                            fmt::format("{:.1f}", w.time() - t_begin) + " s");
     // Checkpoint only when the loop goes on (a resume continues with the next check).
     nlohmann::json st = extra;
-    st["settle"] = {
-        {"t", w.time()}, {"t_begin", t_begin}, {"t_factories", t_factories}, {"quiet", quiet}};
+    st["settle"] = {{"t", w.time()},
+                    {"t_begin", t_begin},
+                    {"t_factories", t_factories},
+                    {"quiet", quiet},
+                    {"removed_kg", c.removed_mass}};
     keep_checkpoint(c, w, phase, st, false);
   }
   s.time = w.time() - t_begin;

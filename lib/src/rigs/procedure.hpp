@@ -46,8 +46,8 @@ struct Ctx {
   Clock::time_point last_checkpoint = Clock::now();
   Clock::time_point last_progress = Clock::now();
   // Clumps whose centre satisfies `outside` have left the rig for good (overflow, discharge,
-  // fallen off the plate): removed from the World; `removed_mass` totals them (phase 2 only
-  // resumes it from the state, see discharge).
+  // fallen off the plate): removed from the World; `removed_mass` totals them (a settle's
+  // checkpoint keeps the total; phase 2 starts it again from 0, see discharge).
   std::function<bool(const Eigen::Vector3d&)> outside = nullptr;
   double removed_mass = 0.0;
   Meter meter = {};
@@ -55,11 +55,13 @@ struct Ctx {
   void say(const std::string& s) const {
     if (req.progress) req.progress(fmt::format("[{} repeat {}] {}", req.rig, repeat + 1, s));
   }
-  // A progress line at most every 5 s of wall time on the long loops (pour, strike-off, lift,
-  // discharge); `line` is formatted only when one is due.
+  // A progress line at most every RigRequest::progress_every (5 s) of wall time on the long
+  // loops (pour, strike-off, lift, discharge); `line` is formatted only when one is due.
   template <class F>
   void progress(F&& line) {
-    if (std::chrono::duration<double>(Clock::now() - last_progress).count() <= 5.0) return;
+    if (std::chrono::duration<double>(Clock::now() - last_progress).count() <= req.progress_every &&
+        req.progress_every > 0.0)
+      return;
     say(line());
     last_progress = Clock::now();
   }

@@ -92,6 +92,9 @@ struct RigRequest {
   /// a later run's bed_from. The calibration's rig runs do not (their cache would double).
   bool keep_bed = true;
   std::function<void(const std::string&)> progress;  ///< one line per call, may be empty
+  /// s of wall-clock time between the progress lines of the long loops (pour, settle, strike-off,
+  /// lift, discharge); 0 = one line per check (tests that stop a run at a given check).
+  double progress_every = 5.0;
   /// Edits the scale's parameters after the settings are applied (tests and studies that need
   /// a rig smaller than `mini`); recorded in the result like any other parameter.
   std::function<void(ScaleParams&)> adjust;
