@@ -37,8 +37,11 @@ for m in models:
             v = q(j, k)
             if v: rows.append([rig, m.split("_")[1][0], f"scale={j['scale']}", k, *v, m])
 md += ["", "| model | rpm | pocket mass kg (paper pocket) | CV | mass flow kg/s |", "|---|---|---|---|---|"]
+discharges = []  # (rpm, run JSON) of the speeds run, for the curves below
 for rpm in (10, 15, 30):
     d = load(f"dis_{rpm}")
+    if d:
+        discharges.append((rpm, d))
     m_, cv, mf = q(d, "pocket_mass"), q(d, "pocket_mass_cv"), q(d, "mass_flow")
     if m_:
         md.append(f"| production | {rpm} | {pm(m_, 3)} (n={m_[2]}) | {pm(cv, 3)} | {pm(mf, 3)} |")
@@ -60,7 +63,7 @@ def curves_svg(runs, path):
     lines = []  # (label, colour, [(t, m)])
     colours = {10: "#1f77b4", 15: "#2ca02c", 30: "#d62728"}
     for rpm, d in runs:
-        for k, r in enumerate(d.get("repeats", [])):
+        for r in d.get("repeats", []):
             det = r.get("details", {})
             t, m = det.get("curve_time_s"), det.get("curve_mass_kg")
             if not t or not m:
@@ -96,8 +99,7 @@ def curves_svg(runs, path):
     return True
 
 
-runs = [(rpm, load(f"dis_{rpm}")) for rpm in (10, 15, 30)]
-if curves_svg([(r, d) for r, d in runs if d], out / "discharge_curves.svg"):
+if curves_svg(discharges, out / "discharge_curves.svg"):
     md.append("\nThe discharge curves of every speed: discharge_curves.svg")
 (out / "study.md").write_text("\n".join(md) + "\n")
 print("\n".join(md))
