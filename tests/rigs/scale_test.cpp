@@ -45,6 +45,29 @@ TEST(RigScale, TheOtherRigsAndScalesKeepTheirParameters) {
   EXPECT_DOUBLE_EQ(mini.bed_mass, 0.08);
 }
 
+TEST(RigScale, TimeStepFractionByScaleAndBySetting) {
+  // 0.3 of the Rayleigh time at tiny and mini, 0.25 at small, 0.2 at paper.
+  const std::pair<const char*, double> by_scale[] = {
+      {"tiny", 0.3}, {"mini", 0.3}, {"small", 0.25}, {"paper", 0.2}};
+  for (const auto& [scale, fraction] : by_scale)
+    for (const char* rig : {"bulk_density", "angle_of_repose", "discharge"})
+      EXPECT_DOUBLE_EQ(rig_scale(rig, {{"scale", scale}}).rayleigh_fraction, fraction)
+          << rig << " " << scale;
+  // --set rayleigh_fraction=F overrides it (0.2 reproduces the paper-scale runs before it),
+  // within (0, 0.4].
+  EXPECT_DOUBLE_EQ(rig_scale("angle_of_repose", {{"scale", "paper"}, {"rayleigh_fraction", "0.2"}})
+                       .rayleigh_fraction,
+                   0.2);
+  for (const char* bad : {"0", "-0.1", "0.41", "nan"}) {
+    try {
+      rig_scale("bulk_density", {{"rayleigh_fraction", bad}});
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("rayleigh_fraction"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(RigScale, AnUnknownRigIsNamed) {
   try {
     rig_scale("hopper", {{"scale", "paper"}});

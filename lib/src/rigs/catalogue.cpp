@@ -35,6 +35,15 @@ const std::vector<RigInfo>& rig_catalogue() {
     const SettingInfo stiffness{
         "stiffness", {}, "1", "1", "factor on every Young's modulus (scale default; 1 = Table 1)",
         false};
+    // The time step, as a fraction of the smallest sphere's Rayleigh time (the scale sets it).
+    const SettingInfo step{"rayleigh_fraction",
+                           {},
+                           "1",
+                           "by scale",
+                           "time step / the smallest sphere's Rayleigh time (scale default: 0.3 at "
+                           "tiny and mini, 0.25 at small, 0.2 at paper; at most 0.4; an impact "
+                           "needs 10 steps, which may cut it)",
+                           false};
     // The engine's implicit-damping gate (WorldSettings::implicit_damping); 0 = off, the time
     // step then cut to the stiffest contact mode's damping rate as before session 10.
     const SettingInfo damping{"implicit_damping",
@@ -58,6 +67,7 @@ const std::vector<RigInfo>& rig_catalogue() {
            "a faster pour)",
            false},
           stiffness,
+          step,
           damping}});
     r.push_back({"angle_of_repose",
                  "lifting cylinder (200 mm/min) on a plate; heap angle from side silhouettes",
@@ -74,6 +84,7 @@ const std::vector<RigInfo>& rig_catalogue() {
                    "pill mass poured (scale default); what the cylinder cannot hold is poured "
                    "from above its top and runs over onto the plate"},
                   stiffness,
+                  step,
                   damping}});
     r.push_back({"discharge",
                  "hopper and 8-pocket wheel at a given speed",
@@ -92,6 +103,7 @@ const std::vector<RigInfo>& rig_catalogue() {
                    "paper scale the bed is 10 kg per 100 mm of slice)"},
                   {"pockets", {}, "1", "8", "pockets measured after the first (scale default)"},
                   stiffness,
+                  step,
                   damping}});
     return r;
   }();

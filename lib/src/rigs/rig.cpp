@@ -100,6 +100,12 @@ ScaleParams rig_scale(const std::string& rig, const std::map<std::string, std::s
     if (*v > 1.0) throw InputError("--set", "stiffness", "must be <= 1 (1 = Table 1)");
     p.stiffness_scale = *v;
   }
+  if (auto v = num("rayleigh_fraction")) {
+    if (!(*v > 0.0 && *v <= 0.4))
+      throw InputError("--set", "rayleigh_fraction",
+                       "must be in (0, 0.4] (time step / Rayleigh time)");
+    p.rayleigh_fraction = *v;
+  }
   if (const auto f = settings.find("implicit_damping"); f != settings.end())
     p.implicit_damping = f->second == "on";
   if (const auto f = settings.find("pour_region"); f != settings.end())
