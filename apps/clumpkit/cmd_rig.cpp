@@ -136,6 +136,8 @@ Command setup_rig(CLI::App& parent) {
             req.bed_from = checked_bed_from(*a, info);
             if (a->vtk && a->out.empty())
               throw InputError("--vtk", "", "VTK output needs --out DIR");
+            // Scale parameters are checked before anything is written or the long run starts.
+            (void)rigs::rig_scale(req.rig, req.settings);
             if (!a->out.empty()) {
               std::error_code ec;
               fs::create_directories(a->out, ec);
@@ -144,8 +146,6 @@ Command setup_rig(CLI::App& parent) {
             }
             if (!a->json.empty() && a->json != "-") check_writable(a->json, "--json");
             req.progress = [](const std::string& s) { std::cerr << s << std::endl; };
-            // Scale parameters are checked before the long run starts.
-            (void)rigs::rig_scale(req.rig, req.settings);
 
             const rigs::RigResult r = rigs::run_rig(req);
             std::cout << fmt::format("{} with model {} at scale {} ({}), {} repeat(s)\n", r.rig,
