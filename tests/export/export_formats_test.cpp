@@ -301,6 +301,13 @@ TEST(ExportYade, ClumpTemplateIsRelativeToTheVolumeEquivalentRadius) {
   ASSERT_TRUE(std::regex_search(py, m, std::regex(R"(R_REF = ([0-9.eE+-]+))")));
   expect_rel(std::stod(m[1]), r_ref, kTol, "R_REF");
   EXPECT_NE(py.find("def add_clump("), std::string::npos);
+  EXPECT_NE(py.find("def set_union_mass("), std::string::npos);
+  // Debian's Yade (2023) has minieigen only as yade.minieigenHP; older ones as minieigen. Whether
+  // the file really runs in Yade is tests/peer/yade_clump.py's check.
+  EXPECT_NE(py.find("from yade.minieigenHP import Vector3"), std::string::npos);
+  EXPECT_NE(py.find("discretization=DISCRETIZATION"), std::string::npos);
+  // Equal spheres 1.9 mm across a 6 mm pill: 20 cells per radius stay under 100 along a side.
+  EXPECT_NE(py.find("\nDISCRETIZATION = 20\n"), std::string::npos);
 }
 
 TEST(ExportVtk, PolyDataOfSphereCentresWithRadius) {
