@@ -114,9 +114,14 @@ compare_json "$dir/a.json" "$dir/b.json" || { echo "FAIL: results differ"; fail=
 for k in 1 2; do
   compare_json "$dir/a/repeat_$k/result.json" "$dir/b/repeat_$k/result.json" ||
     { echo "FAIL: repeat $k: result.json differs"; fail=1; }
-  for f in heap_spheres.vtp filled_spheres.vtp heap.png; do
+  for f in heap_spheres.vtp filled_spheres.vtp heap_wall_plate.vtp heap_wall_tube.vtp heap.png; do
     [ -s "$dir/b/repeat_$k/$f" ] || { echo "FAIL: repeat $k: $f missing"; fail=1; }
   done
+  # The spheres as vertex cells (ParaView draws them), each with its radius; walls with wall_id.
+  grep -q 'NumberOfPoints="\([1-9][0-9]*\)" NumberOfVerts="\1"' "$dir/b/repeat_$k/heap_spheres.vtp" &&
+    grep -q 'Name="radius"' "$dir/b/repeat_$k/heap_spheres.vtp" &&
+    grep -q 'Name="wall_id"' "$dir/b/repeat_$k/heap_wall_plate.vtp" ||
+    { echo "FAIL: repeat $k: the .vtp snapshots lack vertex cells or arrays"; fail=1; }
 done
 [ "$fail" = 0 ] || exit 1
 grep -h '"angle"' -A1 "$dir/a.json" | head -2 | tr -d ' \n'; echo

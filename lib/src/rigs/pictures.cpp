@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <map>
 #include <numbers>
-#include <sstream>
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
@@ -233,44 +232,6 @@ void curve_picture(const std::filesystem::path& path, const std::vector<Curve>& 
     ++k;
   }
   cv.save_png(path);
-}
-
-void write_spheres_vtp(const std::filesystem::path& path, const std::vector<Eigen::Vector3d>& c,
-                       const std::vector<double>& r, const std::vector<int>& clumps) {
-  std::ostringstream o;
-  o.precision(9);
-  o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
-       "byte_order=\"LittleEndian\">\n"
-    << "<PolyData><Piece NumberOfPoints=\"" << c.size()
-    << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" "
-    << "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n<Points><DataArray type=\"Float64\" "
-       "NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : c) o << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  o << "</DataArray></Points>\n<PointData Scalars=\"radius\"><DataArray type=\"Float64\" "
-       "Name=\"radius\" format=\"ascii\">\n";
-  for (double x : r) o << x << '\n';
-  o << "</DataArray><DataArray type=\"Int32\" Name=\"clump\" format=\"ascii\">\n";
-  for (int x : clumps) o << x << '\n';
-  o << "</DataArray></PointData>\n</Piece></PolyData></VTKFile>\n";
-  write_file_atomic(path, o.str());
-}
-
-void write_mesh_vtp(const std::filesystem::path& path, const std::vector<Eigen::Vector3d>& v,
-                    const std::vector<std::array<int, 3>>& t) {
-  std::ostringstream o;
-  o.precision(9);
-  o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
-       "byte_order=\"LittleEndian\">\n"
-    << "<PolyData><Piece NumberOfPoints=\"" << v.size() << "\" NumberOfPolys=\"" << t.size()
-    << "\">\n<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : v) o << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  o << "</DataArray></Points>\n<Polys><DataArray type=\"Int32\" Name=\"connectivity\" "
-       "format=\"ascii\">\n";
-  for (const auto& f : t) o << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
-  o << "</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
-  for (size_t i = 0; i < t.size(); ++i) o << 3 * (i + 1) << '\n';
-  o << "</DataArray></Polys>\n</Piece></PolyData></VTKFile>\n";
-  write_file_atomic(path, o.str());
 }
 
 }  // namespace clumpkit::rigs

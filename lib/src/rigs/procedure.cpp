@@ -7,6 +7,7 @@
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/rigs/pictures.hpp"
+#include "clumpkit/sim/vtk_output.hpp"
 
 namespace clumpkit::rigs::detail {
 
@@ -224,13 +225,10 @@ Spheres world_spheres(const dem::World& w) {
 
 void snapshot(const Ctx& c, const dem::World& w, const std::string& name) {
   if (!c.req.vtk || c.dir.empty()) return;
-  write_spheres_vtp(c.dir / (name + "_spheres.vtp"), w.sphere_positions(), w.sphere_radii(),
-                    w.sphere_clumps());
-  for (int k = 0; k < w.wall_count(); ++k) {
-    std::vector<std::array<int, 3>> tris = w.wall_settings(k).mesh.triangles;
-    write_mesh_vtp(c.dir / fmt::format("{}_wall_{}.vtp", name, w.wall_settings(k).name),
-                   w.wall_vertices(k), tris);
-  }
+  write_file_atomic(c.dir / (name + "_spheres.vtp"), sim::particles_vtp(w));
+  for (int k = 0; k < w.wall_count(); ++k)
+    write_file_atomic(c.dir / fmt::format("{}_wall_{}.vtp", name, w.wall_settings(k).name),
+                      sim::wall_vtp(w, k));
 }
 
 dem::VelocityProfile step_velocity(double t_on, double t_off, const Vector3d& v) {

@@ -46,26 +46,28 @@ std::string particles_vtp(const dem::World& w) {
   return s.str();
 }
 
-std::string walls_vtp(const dem::World& w) {
+namespace {
+// Walls first .. last - 1 as one PolyData; the `wall_id` cell array gives each triangle's wall.
+std::string walls_range_vtp(const dem::World& w, int first, int last) {
   std::ostringstream s;
   header(s);
   size_t nv = 0, nt = 0;
-  for (int k = 0; k < w.wall_count(); ++k) {
+  for (int k = first; k < last; ++k) {
     nv += w.wall_vertices(k).size();
     nt += w.wall_settings(k).mesh.triangles.size();
   }
   s << "<Piece NumberOfPoints=\"" << nv << "\" NumberOfPolys=\"" << nt << "\">\n";
   s << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (int k = 0; k < w.wall_count(); ++k)
+  for (int k = first; k < last; ++k)
     for (const auto& p : w.wall_vertices(k)) s << p[0] << " " << p[1] << " " << p[2] << "\n";
   s << "</DataArray></Points>\n<CellData Scalars=\"wall_id\">\n"
        "<DataArray type=\"Int32\" Name=\"wall_id\" format=\"ascii\">\n";
-  for (int k = 0; k < w.wall_count(); ++k)
+  for (int k = first; k < last; ++k)
     for (size_t t = 0; t < w.wall_settings(k).mesh.triangles.size(); ++t) s << k << "\n";
   s << "</DataArray>\n</CellData>\n<Polys><DataArray type=\"Int64\" Name=\"connectivity\" "
        "format=\"ascii\">\n";
   size_t base = 0;
-  for (int k = 0; k < w.wall_count(); ++k) {
+  for (int k = first; k < last; ++k) {
     for (const auto& t : w.wall_settings(k).mesh.triangles)
       s << base + t[0] << " " << base + t[1] << " " << base + t[2] << "\n";
     base += w.wall_vertices(k).size();
@@ -74,6 +76,15 @@ std::string walls_vtp(const dem::World& w) {
   for (size_t t = 0; t < nt; ++t) s << 3 * (t + 1) << "\n";
   s << "</DataArray></Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
   return s.str();
+}
+}  // namespace
+
+std::string walls_vtp(const dem::World& w) {
+  return walls_range_vtp(w, 0, w.wall_count());
+}
+
+std::string wall_vtp(const dem::World& w, int wall) {
+  return walls_range_vtp(w, wall, wall + 1);
 }
 
 std::string pvd(const std::vector<std::pair<double, std::string>>& frames) {

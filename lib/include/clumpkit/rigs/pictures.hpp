@@ -45,13 +45,4 @@ struct Curve {
 void curve_picture(const std::filesystem::path& path, const std::vector<Curve>& curves,
                    const std::string& x_label, const std::string& y_label);
 
-/// VTK XML PolyData (.vtp): sphere centres with a "radius" and a "clump" point array (ParaView:
-/// Glyph filter, scale by radius), written atomically.
-void write_spheres_vtp(const std::filesystem::path& path,
-                       const std::vector<Eigen::Vector3d>& centers,
-                       const std::vector<double>& radii, const std::vector<int>& clumps);
-/// A triangle mesh as .vtp.
-void write_mesh_vtp(const std::filesystem::path& path, const std::vector<Eigen::Vector3d>& vertices,
-                    const std::vector<std::array<int, 3>>& triangles);
-
 }  // namespace clumpkit::rigs

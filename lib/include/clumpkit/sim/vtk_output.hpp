@@ -14,6 +14,8 @@ namespace clumpkit::sim {
 std::string particles_vtp(const dem::World& world);
 /// All walls' current triangles with a `wall_id` cell array.
 std::string walls_vtp(const dem::World& world);
+/// One wall's current triangles (its `wall_id` on every cell).
+std::string wall_vtp(const dem::World& world, int wall);
 /// A ParaView collection of (time, file) frames.
 std::string pvd(const std::vector<std::pair<double, std::string>>& frames);
 
