@@ -9,7 +9,8 @@ run (`yade -n -x`) loads every exported file and checks, per template:
   * add_clump: one clump of len(RADII) member spheres, each at centre + POSITIONS[i] with radius
     RADII[i]; Yade's reference point (its centre of mass, from its grid integration of the union at
     DISCRETIZATION) within 0.02 of the smallest radius of the centre asked for, which is
-    clumpkit's union centre of mass; mass and sorted principal moments exactly clumpkit's;
+    clumpkit's union centre of mass; mass and sorted principal moments exactly clumpkit's; the
+    same with an orientation (each sphere at centre + q POSITIONS[i]);
   * independent of clumpkit's numbers: Yade's own grid integration of the union (appendClumped
     with discretization=40) gives the centre of mass within 0.005 r_min, the mass within 0.5 % and
     the sorted principal moments within 1 % of clumpkit's ray-sampled union values; Yade's sum
@@ -58,6 +59,17 @@ for path in files:
     r["com_offset"] = (b.state.pos - c).norm() / rmin
     r["add_mass"] = b.state.mass
     r["add_moments"] = sorted(b.state.inertia[k] for k in range(3))
+    # Turned: each sphere at centre + q p, the same union mass and moments.
+    q = Quaternion(Vector3(0.3, -0.5, 0.8).normalized(), 1.1)
+    c2 = Vector3(0.05, 0.0, 0.03)
+    cid2 = ns["add_clump"](c2, material=mat, orientation=q)
+    b2 = O.bodies[cid2]
+    m2 = sorted(b2.shape.members.keys())
+    r["turned_pos_err"] = max((O.bodies[m].state.pos - c2 - q * Vector3(*p)).norm()
+                              for m, p in zip(m2, P)) / rmin
+    r["turned_com_offset"] = (b2.state.pos - c2).norm() / rmin
+    r["turned_moments"] = sorted(b2.state.inertia[k] for k in range(3))
+    O.bodies.erase(cid2, True)
     # Free fall: no contact, so no torque.
     O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
                  InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
@@ -176,6 +188,10 @@ def main():
         check(r["grid_com_offset"] < 0.005, f"{name}: Yade's grid centre of mass "
               f"{r['grid_com_offset']:.4f} r_min from clumpkit's")
         check(rel(r["add_mass"], r["mass"]) < 1e-12, f"{name}: add_clump mass {r['add_mass']}")
+        check(r["turned_pos_err"] < 1e-9 and r["turned_com_offset"] < 0.02 and
+              max(rel(x, y) for x, y in zip(r["turned_moments"], r["moments"])) < 1e-12,
+              f"{name}: add_clump with an orientation: spheres off by {r['turned_pos_err']:.2e}, "
+              f"centre {r['turned_com_offset']:.4f} r_min, moments {r['turned_moments']}")
         check(max(rel(x, y) for x, y in zip(r["add_moments"], r["moments"])) < 1e-12,
               f"{name}: add_clump moments {r['add_moments']} against {r['moments']}")
         check(rel(r["grid_mass"], r["mass"]) < 0.005, f"{name}: Yade's grid mass "

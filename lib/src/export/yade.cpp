@@ -113,9 +113,11 @@ def set_union_mass(clump_id):
     state.inertia = Vector3(*moments)
 
 
-def add_clump(center, material=-1, union_mass=True):
+def add_clump(center, material=-1, union_mass=True, orientation=None):
     """Appends the clump at true size with its centre of mass at `center` (m) and returns the
-    clump's body id. With union_mass (the default), Yade integrates the union on its grid
+    clump's body id. `orientation` (a Yade Quaternion; None = the template's frame) turns the
+    clump about its centre of mass, e.g. Quaternion(axis, angle) with a random axis and angle
+    for a random packing. With union_mass (the default), Yade integrates the union on its grid
     (DISCRETIZATION), which puts the clump's reference point at the union's centre of mass, and
     the mass and principal moments are then set to the union's exact values (set_union_mass).
     Without it, Yade's own sum over the spheres stands (overlaps counted more than once).
@@ -125,8 +127,10 @@ def add_clump(center, material=-1, union_mass=True):
     by its own coarse grid estimate of the template's volume, so a replaced sphere of radius
     R_REF gives the clump within about 1 % of its true size, not exactly at it."""
     c = Vector3(*center)
+    turn = (lambda v: orientation * v) if orientation is not None else (lambda v: v)
     clump_id, _ = O.bodies.appendClumped(
-        [utils.sphere(c + Vector3(*p), r, material=material) for p, r in zip(POSITIONS, RADII)],
+        [utils.sphere(c + turn(Vector3(*p)), r, material=material)
+         for p, r in zip(POSITIONS, RADII)],
         discretization=DISCRETIZATION if union_mass else 0)
     if union_mass:
         set_union_mass(clump_id)
