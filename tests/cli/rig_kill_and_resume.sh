@@ -118,9 +118,10 @@ for k in 1 2; do
     [ -s "$dir/b/repeat_$k/$f" ] || { echo "FAIL: repeat $k: $f missing"; fail=1; }
   done
   # The spheres as vertex cells (ParaView draws them), each with its radius; walls with wall_id.
-  grep -q 'NumberOfPoints="\([1-9][0-9]*\)" NumberOfVerts="\1"' "$dir/b/repeat_$k/heap_spheres.vtp" &&
-    grep -q 'Name="radius"' "$dir/b/repeat_$k/heap_spheres.vtp" &&
-    grep -q 'Name="wall_id"' "$dir/b/repeat_$k/heap_wall_plate.vtp" ||
+  rep="$dir/b/repeat_$k"
+  grep -q 'NumberOfPoints="\([1-9][0-9]*\)" NumberOfVerts="\1"' "$rep/heap_spheres.vtp" &&
+    grep -q 'Name="radius"' "$rep/heap_spheres.vtp" &&
+    grep -q 'Name="wall_id"' "$rep/heap_wall_plate.vtp" ||
     { echo "FAIL: repeat $k: the .vtp snapshots lack vertex cells or arrays"; fail=1; }
 done
 [ "$fail" = 0 ] || exit 1

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""clumpkit's Yade export, run in a real Yade (Debian's `yade`), checked against clumpkit's own figures.
+"""clumpkit's Yade export run in a real Yade (Debian's `yade`), against clumpkit's own figures.
 
 Templates: the paper's nine pills (`clumpkit paper --out`) and an asymmetric clump (the bundled
 rock, 10 spheres by the optimiser), each exported with `clumpkit export --format yade`. One Yade
@@ -35,7 +35,7 @@ import sys
 
 # Runs inside Yade: O, utils, Vector3 and the engines are in its globals.
 DRIVER = r'''
-import json, math, sys
+import json, sys
 files = json.load(open(sys.argv[1]))
 out = []
 for path in files:
@@ -78,12 +78,11 @@ for path in files:
     O.dt = 1e-5
     z0, q0 = b.state.pos[2], b.state.ori
     O.run(200, True)
-    # Yade's leapfrog from rest: v after k steps k g dt, so the fall after n is g dt^2 n (n + 1) / 2.
+    # Yade's leapfrog from rest: v = k g dt after k steps, so n steps fall g dt^2 n (n + 1) / 2.
     n = round(O.time / O.dt)
     r["fall"] = z0 - b.state.pos[2]
     r["fall_expected"] = 0.5 * 9.81 * O.dt * O.dt * n * (n + 1)
-    r["turn"] = (b.state.ori.conjugate() * q0).angle() if hasattr(q0, "angle") else 0.0
-    r["turn"] = abs(r["turn"]) if r["turn"] <= math.pi else abs(2 * math.pi - r["turn"])
+    r["turn"] = b.state.ori.angularDistance(q0)
     # Yade's own estimates of the union: grid (discretization 40) and the sum over spheres.
     O.reset()
     mat = O.materials.append(FrictMat(density=ns["DENSITY"], young=1e7, poisson=0.3,
@@ -167,9 +166,9 @@ def main():
             print("FAIL " + what)
 
     rel = lambda x, y: abs(x - y) / abs(y)
-    print("Yade against clumpkit's union: centre-of-mass offsets in smallest radii (add_clump, Yade's\n"
-          "grid at 40, Yade's sum over spheres), grid mass and largest moment error, the sum's mass,\n"
-          "replaceByClumps's size on a sphere of R_REF")
+    print("Yade against clumpkit's union: centre-of-mass offsets in smallest radii (add_clump,\n"
+          "Yade's grid at 40, Yade's sum over spheres), grid mass and largest moment error, the\n"
+          "sum's mass, replaceByClumps's size on a sphere of R_REF")
     print(f"{'template':<24} {'n':>3} {'add COM':>8} {'grid COM':>8} {'sum COM':>8} "
           f"{'grid mass':>10} {'grid I':>7} {'sum mass':>9} {'replace':>8}")
     for r in res:
@@ -179,10 +178,12 @@ def main():
               f"{r['sum_com_offset']:>8.4f} "
               f"{r['grid_mass'] / r['mass'] - 1:>+10.3%} {grid_i:>7.2%} "
               f"{r['sum_mass'] / r['mass']:>8.3f}x {r['replace_size_ratio']:>8.4f}")
-        check(r["members"] == r["spheres"], f"{name}: {r['members']} members, {r['spheres']} spheres")
+        check(r["members"] == r["spheres"],
+              f"{name}: {r['members']} members, {r['spheres']} spheres")
         check(r["member_pos_err"] < 1e-9, f"{name}: member positions off by "
               f"{r['member_pos_err']:.2e} r_min")
-        check(r["member_radius_err"] < 1e-12, f"{name}: member radii off by {r['member_radius_err']:.2e}")
+        check(r["member_radius_err"] < 1e-12,
+              f"{name}: member radii off by {r['member_radius_err']:.2e}")
         check(r["com_offset"] < 0.02, f"{name}: add_clump's reference point {r['com_offset']:.4f} "
               "r_min from clumpkit's centre of mass")
         check(r["grid_com_offset"] < 0.005, f"{name}: Yade's grid centre of mass "
