@@ -302,6 +302,10 @@ TEST(ExportYade, ClumpTemplateIsRelativeToTheVolumeEquivalentRadius) {
   expect_rel(std::stod(m[1]), r_ref, kTol, "R_REF");
   EXPECT_NE(py.find("def add_clump("), std::string::npos);
   EXPECT_NE(py.find("def set_union_mass("), std::string::npos);
+  // Yade's coarse volume estimate replayed: within a few % of R_REF (1e-15 in real Yade is
+  // tests/peer/yade_clump.py's check).
+  ASSERT_TRUE(std::regex_search(py, m, std::regex(R"(R_REPLACE = ([0-9.eE+-]+))")));
+  EXPECT_NEAR(std::stod(m[1]) / r_ref, 1.0, 0.03);
   // Debian's Yade (2023) has minieigen only as yade.minieigenHP; older ones as minieigen. Whether
   // the file really runs in Yade is tests/peer/yade_clump.py's check.
   EXPECT_NE(py.find("from yade.minieigenHP import Vector3"), std::string::npos);

@@ -17,7 +17,8 @@ run (`yade -n -x`) loads every exported file and checks, per template:
     over the spheres (discretization=0) exceeds the union's mass wherever the spheres overlap;
   * replaceByClumps with TEMPLATE on a sphere of radius R_REF: the clump's member radii within
     1.5 % of RADII (Yade sizes by its own coarse grid estimate of the template's volume; the
-    ratio is reported), then set_union_mass gives clumpkit's mass;
+    ratio is reported); on a sphere of radius R_REPLACE, which replays that estimate, within
+    1e-9; then set_union_mass gives clumpkit's mass;
   * free fall for 200 steps: the clump moves as one rigid body, its centre of mass falling as
     Yade's leapfrog predicts from rest (g dt^2 n (n + 1) / 2, 1e-9 relative), without turning (no
     contact, no torque).
@@ -100,15 +101,17 @@ for path in files:
     O.reset()
     mat = O.materials.append(FrictMat(density=ns["DENSITY"], young=1e7, poisson=0.3,
                                       frictionAngle=0.5))
-    O.bodies.append(utils.sphere(c, ns["R_REF"], material=mat))
-    (cid, mids), = O.bodies.replaceByClumps([ns["TEMPLATE"]], [1.0],
-                                            discretization=ns["DISCRETIZATION"])
-    ratios = sorted(x / q for x, q in zip(sorted(O.bodies[m].shape.radius for m in mids),
-                                           sorted(R)))
-    r["replace_size_ratio"] = sum(ratios) / len(ratios)
-    r["replace_ratio_spread"] = ratios[-1] - ratios[0]
-    ns["set_union_mass"](cid)
-    r["replace_mass"] = O.bodies[cid].state.mass
+    for key in ("R_REF", "R_REPLACE"):
+        O.bodies.clear()
+        O.bodies.append(utils.sphere(c, ns[key], material=mat))
+        (cid, mids), = O.bodies.replaceByClumps([ns["TEMPLATE"]], [1.0],
+                                                discretization=ns["DISCRETIZATION"])
+        ratios = sorted(x / q for x, q in zip(sorted(O.bodies[m].shape.radius for m in mids),
+                                               sorted(R)))
+        r[key + "_size_ratio"] = sum(ratios) / len(ratios)
+        r[key + "_ratio_spread"] = ratios[-1] - ratios[0]
+        ns["set_union_mass"](cid)
+        r[key + "_mass"] = O.bodies[cid].state.mass
     out.append(r)
 json.dump(out, open(sys.argv[2], "w"), indent=1)
 '''
@@ -168,16 +171,18 @@ def main():
     rel = lambda x, y: abs(x - y) / abs(y)
     print("Yade against clumpkit's union: centre-of-mass offsets in smallest radii (add_clump,\n"
           "Yade's grid at 40, Yade's sum over spheres), grid mass and largest moment error, the\n"
-          "sum's mass, replaceByClumps's size on a sphere of R_REF")
+          "sum's mass, replaceByClumps's size (ratio; R_REPLACE: minus 1) on a sphere of R_REF\n"
+          "and of R_REPLACE")
     print(f"{'template':<24} {'n':>3} {'add COM':>8} {'grid COM':>8} {'sum COM':>8} "
-          f"{'grid mass':>10} {'grid I':>7} {'sum mass':>9} {'replace':>8}")
+          f"{'grid mass':>10} {'grid I':>7} {'sum mass':>9} {'R_REF':>8} {'R_REPLACE':>9}")
     for r in res:
         name = os.path.basename(r["file"])[:-8]
         grid_i = max(rel(x, y) for x, y in zip(r["grid_moments"], r["moments"]))
         print(f"{name:<24} {r['spheres']:>3} {r['com_offset']:>8.4f} {r['grid_com_offset']:>8.4f} "
               f"{r['sum_com_offset']:>8.4f} "
               f"{r['grid_mass'] / r['mass'] - 1:>+10.3%} {grid_i:>7.2%} "
-              f"{r['sum_mass'] / r['mass']:>8.3f}x {r['replace_size_ratio']:>8.4f}")
+              f"{r['sum_mass'] / r['mass']:>8.3f}x {r['R_REF_size_ratio']:>8.4f} "
+              f"{r['R_REPLACE_size_ratio'] - 1:>+9.1e}")
         check(r["members"] == r["spheres"],
               f"{name}: {r['members']} members, {r['spheres']} spheres")
         check(r["member_pos_err"] < 1e-9, f"{name}: member positions off by "
@@ -202,10 +207,13 @@ def main():
         if r["spheres"] > 1:
             check(r["sum_mass"] > 1.01 * r["mass"], f"{name}: the sum over overlapping spheres "
                   f"({r['sum_mass']:.6g} kg) should exceed the union's")
-        check(abs(r["replace_size_ratio"] - 1) < 0.015 and r["replace_ratio_spread"] < 1e-9,
-              f"{name}: replaceByClumps size ratio {r['replace_size_ratio']:.4f}")
-        check(rel(r["replace_mass"], r["mass"]) < 1e-12, f"{name}: set_union_mass after "
-              f"replaceByClumps gave {r['replace_mass']}")
+        check(abs(r["R_REF_size_ratio"] - 1) < 0.015 and r["R_REF_ratio_spread"] < 1e-9,
+              f"{name}: replaceByClumps on R_REF: size ratio {r['R_REF_size_ratio']:.4f}")
+        check(abs(r["R_REPLACE_size_ratio"] - 1) < 1e-9 and r["R_REPLACE_ratio_spread"] < 1e-9,
+              f"{name}: replaceByClumps on R_REPLACE: size ratio "
+              f"{r['R_REPLACE_size_ratio']:.12f}, not 1 (Yade's volume estimate not replayed)")
+        check(rel(r["R_REPLACE_mass"], r["mass"]) < 1e-12, f"{name}: set_union_mass after "
+              f"replaceByClumps gave {r['R_REPLACE_mass']}")
         check(rel(r["fall"], r["fall_expected"]) < 1e-9, f"{name}: free fall {r['fall']:.9g} m "
               f"against {r['fall_expected']:.9g}")
         check(r["turn"] < 1e-9, f"{name}: turned {r['turn']:.2e} rad in free fall")

@@ -1,9 +1,12 @@
 // Yade: a Python file for yade scripts. clumpTemplate() takes dimensionless radii and positions
-// that BodyContainer.replaceByClumps() scales so the clump's volume equals the volume of the
-// sphere it replaces; we give them in units of the union's volume-equivalent radius R_REF, so a
-// replaced sphere of radius R_REF yields the clump at its true size. Absolute values, the union's
-// mass properties and a helper that appends the clump at true size follow.
+// that BodyContainer.replaceByClumps() scales so the clump's volume, by Yade's grid estimate,
+// equals the volume of the sphere it replaces; we give them in units of the union's
+// volume-equivalent radius R_REF, and R_REPLACE, the sphere radius that Yade's estimate turns into
+// the clump at true size. Absolute values, the union's mass properties and helpers that append the
+// clump at true size with the union's mass properties follow.
 #include <fmt/format.h>
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -43,6 +46,37 @@ int yade_discretization(const Spheres& s) {
   const double cells = kYadeMaxCells * r_min / (hi - lo).maxCoeff();
   return static_cast<int>(std::clamp(std::floor(cells), 1.0, 20.0));
 }
+
+// Yade's replaceByClumps sizes a clump by its own estimate of the template's volume: a grid over
+// the template's box (cell edge the smallest relative radius / 5, or the box's longest side / 150
+// if that is coarser), counting the cells whose centre lies inside a sphere, in Yade's loop order
+// and arithmetic. A sphere of radius r becomes the template scaled by cbrt((4/3 pi r^3) / V).
+// Returns the r that gives the scale r_ref, i.e. the clump at true size (docs/export.md).
+double yade_replace_radius(const std::vector<double>& rel_r,
+                           const std::vector<Eigen::Vector3d>& rel_p, double r_ref) {
+  Eigen::AlignedBox3d box;
+  double r_min = INFINITY;
+  for (size_t i = 0; i < rel_r.size(); ++i) {
+    box.extend(rel_p[i] + Eigen::Vector3d::Constant(rel_r[i]));
+    box.extend(rel_p[i] - Eigen::Vector3d::Constant(rel_r[i]));
+    r_min = std::min(r_min, rel_r[i]);
+  }
+  double dx = r_min / 5.;
+  const double longest = (box.max() - box.min()).maxCoeff();
+  if (longest / dx > 150) dx = longest / 150;
+  const double dv = std::pow(dx, 3);
+  double volume = 0.0;
+  Eigen::Vector3d x;
+  for (x.x() = box.min().x() + dx / 2.; x.x() < box.max().x(); x.x() += dx)
+    for (x.y() = box.min().y() + dx / 2.; x.y() < box.max().y(); x.y() += dx)
+      for (x.z() = box.min().z() + dx / 2.; x.z() < box.max().z(); x.z() += dx)
+        for (size_t i = 0; i < rel_r.size(); ++i)
+          if ((x - rel_p[i]).squaredNorm() < std::pow(rel_r[i], 2)) {
+            volume += dv;
+            break;
+          }
+  return r_ref * std::cbrt(3.0 * volume / (4.0 * std::numbers::pi));
+}
 }  // namespace
 
 std::vector<ExportFile> render_yade(const ClumpTemplate& c, const ExportSettings& s) {
@@ -52,9 +86,11 @@ std::vector<ExportFile> render_yade(const ClumpTemplate& c, const ExportSettings
   const MassProperties& m = c.mass;
   const double r_ref = std::cbrt(3.0 * m.volume / (4.0 * std::numbers::pi));
   std::vector<double> radii, rel_radii;
+  std::vector<Eigen::Vector3d> rel_centres;
   for (const Sphere& sp : c.spheres) {
     radii.push_back(sp.radius);
     rel_radii.push_back(sp.radius / r_ref);
+    rel_centres.push_back(sp.center / r_ref);
   }
   std::string o = provenance_block(c, "yade", "# ");
   o += "# Run inside Yade (yade script.py). Lengths in m, masses in kg.\n";
@@ -89,6 +125,12 @@ std::vector<ExportFile> render_yade(const ClumpTemplate& c, const ExportSettings
   o += fmt::format("TEMPLATE = utils.clumpTemplate(\n    relRadii={},\n    relPositions={})\n\n",
                    py_list(rel_radii), py_points(c.spheres, r_ref));
   o += fmt::format(
+      "# replaceByClumps([TEMPLATE], ...) sizes the clump by Yade's own grid estimate of the\n"
+      "# template's volume, not the exact one: a sphere of radius R_REPLACE (not R_REF) becomes\n"
+      "# the clump at true size. R_REPLACE replays that estimate (Yade 2023's algorithm).\n"
+      "R_REPLACE = {}  # m\n",
+      num(yade_replace_radius(rel_radii, rel_centres, r_ref)));
+  o += fmt::format(
       "# Cells per smallest sphere radius of Yade's grid integration of the union\n"
       "# (appendClumped, replaceByClumps): 20, or fewer so that the clump's longest side has\n"
       "# at most {} cells. With 0 Yade sums the member spheres, overlaps and all: their mass,\n"
@@ -122,10 +164,9 @@ def add_clump(center, material=-1, union_mass=True, orientation=None):
     the mass and principal moments are then set to the union's exact values (set_union_mass).
     Without it, Yade's own sum over the spheres stands (overlaps counted more than once).
 
-    Replacing spheres by TEMPLATE instead (O.bodies.replaceByClumps([TEMPLATE], [amount],
-    discretization=DISCRETIZATION), then set_union_mass on each new clump): Yade sizes the clump
-    by its own coarse grid estimate of the template's volume, so a replaced sphere of radius
-    R_REF gives the clump within about 1 % of its true size, not exactly at it."""
+    Replacing spheres by TEMPLATE instead: O.bodies.replaceByClumps([TEMPLATE], [amount],
+    discretization=DISCRETIZATION), then set_union_mass on each new clump. Spheres of radius
+    R_REPLACE become clumps at true size (R_REF gives them within about 1 %)."""
     c = Vector3(*center)
     turn = (lambda v: orientation * v) if orientation is not None else (lambda v: v)
     clump_id, _ = O.bodies.appendClumped(
