@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "clumpkit/fill/fill_problem.hpp"
 #include "clumpkit/fill/paper_fill.hpp"
+#include "clumpkit/fill/shape_library.hpp"
 #include "clumpkit/geometry/clump_template.hpp"
 #include "clumpkit/geometry/shape_spec.hpp"
 
@@ -22,6 +24,28 @@ inline const ClumpTemplate& pill_template() {
     req.spheres = 12;
     ClumpTemplate c = paper_fill_template(cylinder_shape("pill_B", 6.0e-3, 5.8e-3, 1380.0), req);
     c.name = "pill_B_12";
+    return c;
+  }();
+  return t;
+}
+
+/// An asymmetric clump: the bundled rock filled by the EDT baseline with 8 spheres of unequal
+/// radii (no symmetry puts its centre of mass or principal axes anywhere special).
+inline const ClumpTemplate& asymmetric_template() {
+  static const ClumpTemplate t = [] {
+    auto solid = make_test_shape("rock");
+    FillShape shape{solid, nullptr, "rock"};
+    if (solid->has_exact_distance())
+      shape.exact_distance = [solid](const Eigen::Vector3d& p) {
+        return solid->signed_distance(p);
+      };
+    FillOptions o;
+    o.spheres = 8;
+    const FillResult r = edt_fill(shape, o);
+    RaySamplingOptions sampling;
+    const FillMeasurement m = measure_fill(shape, r.spheres, sampling);
+    ClumpTemplate c = fill_template("edt", o, r, m, 1380.0, sampling);
+    c.name = "rock_edt_8";
     return c;
   }();
   return t;
