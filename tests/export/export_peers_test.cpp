@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <regex>
 
@@ -198,6 +199,72 @@ TEST(ExportPeers, LiggghtsInsertsTheExportedClumps) {
 // tensor as given, so the centroid-principal frame is what makes this right.
 TEST(ExportPeers, LiggghtsInsertsAnAsymmetricClump) {
   liggghts_inserts(test::asymmetric_template());
+}
+
+// Where users outgrow one machine, clumps run in LIGGGHTS with MPI. The same deck on two ranks
+// split at z = 20 mm, the clumps inserted wholly above that plane, falling 60 000 steps onto the
+// floor: each clump must pass from one rank to the other and land whole and rigid (its spheres'
+// distances as in the template).
+TEST(ExportPeers, LiggghtsRunsAnAsymmetricClumpAcrossTwoMpiRanks) {
+  const std::string liggghts = test::which("liggghts"), mpirun = test::which("mpirun");
+  if (liggghts.empty() || mpirun.empty())
+    GTEST_SKIP() << "liggghts or mpirun is not installed (apt-get install liggghts openmpi-bin)";
+  const ClumpTemplate& c = test::asymmetric_template();
+  const fs::path dir = test::scratch_dir("");
+  export_clump(c, "liggghts", dir);
+  std::string deck = liggghts_deck(c.name + ".liggghts", "pts_" + c.name);
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = deck.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    deck.replace(at, from.size(), to);
+  };
+  replace("boundary ", "processors      1 1 2\nboundary ");
+  replace("0.008 0.036 units box", "0.022 0.036 units box");
+  replace("thermo 500\nrun 2000\n",
+          "thermo 10000\ndump fin all custom 60000 fin.txt id x y z radius\n"
+          "dump_modify fin sort id format \"%d %.17g %.17g %.17g %.17g\"\nrun 60000\n");
+  { std::ofstream(dir / "in.deck") << deck; }
+  const int rc = test::run("cd " + test::quoted(dir) + " && timeout 300 " + mpirun +
+                           " --allow-run-as-root --oversubscribe -np 2 " + liggghts +
+                           " -in in.deck -log log.liggghts > screen.txt 2>&1");
+  const std::string log = test::slurp(dir / "log.liggghts");
+  ASSERT_EQ(rc, 0) << test::slurp(dir / "screen.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(log, m, std::regex(R"(Loop time of \S+ on (\d+) procs)"))) << log;
+  EXPECT_EQ(std::stoi(m[1]), 2);
+  const auto [steps, atoms] = loop_steps_atoms(log);
+  EXPECT_EQ(steps, 60000);
+  const size_t n = c.spheres.size();
+  ASSERT_EQ(atoms, static_cast<long>(kClumps * n));
+  // The last dump: id x y z radius per sphere, ids in insertion order, n per clump.
+  const auto lines = test::lines_of(test::slurp(dir / "fin.txt"));
+  std::vector<std::vector<double>> rows;
+  for (size_t i = 0; i < lines.size(); ++i)
+    if (lines[i].rfind("ITEM: ATOMS", 0) == 0) {
+      rows.clear();
+      for (size_t j = i + 1; j < lines.size() && lines[j].rfind("ITEM:", 0) != 0; ++j)
+        rows.push_back(test::numbers(lines[j]));
+    }
+  ASSERT_EQ(rows.size(), kClumps * n);
+  for (int k = 0; k < kClumps; ++k) {
+    double lowest = INFINITY, z_sum = 0.0;
+    for (size_t a = 0; a < n; ++a) {
+      const auto& p = rows[k * n + a];
+      ASSERT_EQ(p.size(), 5u);
+      test::expect_rel(p[4], c.spheres[a].radius, 1e-12, "sphere radius in LIGGGHTS");
+      lowest = std::min(lowest, p[3] - p[4]);
+      for (size_t b = a + 1; b < n; ++b) {
+        const auto& q = rows[k * n + b];
+        const double d = std::hypot(p[1] - q[1], p[2] - q[2], p[3] - q[3]);
+        test::expect_rel(d, (c.spheres[a].center - c.spheres[b].center).norm(), 1e-6,
+                         "distance between two spheres of one clump");
+      }
+      z_sum += p[3];
+    }
+    EXPECT_LT(z_sum / n, 0.02) << "clump " << k << " stayed on the upper rank";
+    // Resting on the floor (or on another clump; then its lowest point is above the floor).
+    EXPECT_GT(lowest, -1e-4) << "clump " << k << " sank through the floor";
+  }
 }
 
 TEST(ExportPeers, LammpsReadsTheMoleculeAndUsesTheUnionMassProperties) {
