@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "clumpkit/core/error.hpp"
+#include "clumpkit/geometry/sphere.hpp"
 #include "format_text.hpp"
 
 namespace clumpkit::export_detail {
@@ -35,15 +36,13 @@ std::string py_points(const Spheres& s, double scale) {
 // pills, docs/export.md), but no more than kYadeMaxCells along the box's longest side, so a
 // clump with a tiny sphere does not cost Yade seconds per clump.
 constexpr int kYadeMaxCells = 100;
+double smallest_radius(const Spheres& s) {
+  double r = INFINITY;
+  for (const Sphere& sp : s) r = std::min(r, sp.radius);
+  return r;
+}
 int yade_discretization(const Spheres& s) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
-  double r_min = INFINITY;
-  for (const Sphere& sp : s) {
-    lo = lo.cwiseMin(sp.center - Eigen::Vector3d::Constant(sp.radius));
-    hi = hi.cwiseMax(sp.center + Eigen::Vector3d::Constant(sp.radius));
-    r_min = std::min(r_min, sp.radius);
-  }
-  const double cells = kYadeMaxCells * r_min / (hi - lo).maxCoeff();
+  const double cells = kYadeMaxCells * smallest_radius(s) / bounds(s).sizes().maxCoeff();
   return static_cast<int>(std::clamp(std::floor(cells), 1.0, 20.0));
 }
 
@@ -52,17 +51,10 @@ int yade_discretization(const Spheres& s) {
 // if that is coarser), counting the cells whose centre lies inside a sphere, in Yade's loop order
 // and arithmetic. A sphere of radius r becomes the template scaled by cbrt((4/3 pi r^3) / V).
 // Returns the r that gives the scale r_ref, i.e. the clump at true size (docs/export.md).
-double yade_replace_radius(const std::vector<double>& rel_r,
-                           const std::vector<Eigen::Vector3d>& rel_p, double r_ref) {
-  Eigen::AlignedBox3d box;
-  double r_min = INFINITY;
-  for (size_t i = 0; i < rel_r.size(); ++i) {
-    box.extend(rel_p[i] + Eigen::Vector3d::Constant(rel_r[i]));
-    box.extend(rel_p[i] - Eigen::Vector3d::Constant(rel_r[i]));
-    r_min = std::min(r_min, rel_r[i]);
-  }
-  double dx = r_min / 5.;
-  const double longest = (box.max() - box.min()).maxCoeff();
+double yade_replace_radius(const Spheres& rel, double r_ref) {
+  const Eigen::AlignedBox3d box = bounds(rel);
+  double dx = smallest_radius(rel) / 5.;
+  const double longest = box.sizes().maxCoeff();
   if (longest / dx > 150) dx = longest / 150;
   const double dv = std::pow(dx, 3);
   double volume = 0.0;
@@ -70,8 +62,8 @@ double yade_replace_radius(const std::vector<double>& rel_r,
   for (x.x() = box.min().x() + dx / 2.; x.x() < box.max().x(); x.x() += dx)
     for (x.y() = box.min().y() + dx / 2.; x.y() < box.max().y(); x.y() += dx)
       for (x.z() = box.min().z() + dx / 2.; x.z() < box.max().z(); x.z() += dx)
-        for (size_t i = 0; i < rel_r.size(); ++i)
-          if ((x - rel_p[i]).squaredNorm() < std::pow(rel_r[i], 2)) {
+        for (const Sphere& sp : rel)
+          if ((x - sp.center).squaredNorm() < std::pow(sp.radius, 2)) {
             volume += dv;
             break;
           }
@@ -86,11 +78,11 @@ std::vector<ExportFile> render_yade(const ClumpTemplate& c, const ExportSettings
   const MassProperties& m = c.mass;
   const double r_ref = std::cbrt(3.0 * m.volume / (4.0 * std::numbers::pi));
   std::vector<double> radii, rel_radii;
-  std::vector<Eigen::Vector3d> rel_centres;
+  Spheres rel;  // in units of R_REF: the template Yade sees
   for (const Sphere& sp : c.spheres) {
     radii.push_back(sp.radius);
     rel_radii.push_back(sp.radius / r_ref);
-    rel_centres.push_back(sp.center / r_ref);
+    rel.push_back({sp.center / r_ref, sp.radius / r_ref});
   }
   std::string o = provenance_block(c, "yade", "# ");
   o += "# Run inside Yade (yade script.py). Lengths in m, masses in kg.\n";
@@ -123,13 +115,13 @@ std::vector<ExportFile> render_yade(const ClumpTemplate& c, const ExportSettings
   o += fmt::format("POSITIONS = {}  # m, relative to the centre of mass\n\n",
                    py_points(c.spheres, 1.0));
   o += fmt::format("TEMPLATE = utils.clumpTemplate(\n    relRadii={},\n    relPositions={})\n\n",
-                   py_list(rel_radii), py_points(c.spheres, r_ref));
+                   py_list(rel_radii), py_points(rel, 1.0));
   o += fmt::format(
       "# replaceByClumps([TEMPLATE], ...) sizes the clump by Yade's own grid estimate of the\n"
       "# template's volume, not the exact one: a sphere of radius R_REPLACE (not R_REF) becomes\n"
       "# the clump at true size. R_REPLACE replays that estimate (Yade 2023's algorithm).\n"
       "R_REPLACE = {}  # m\n",
-      num(yade_replace_radius(rel_radii, rel_centres, r_ref)));
+      num(yade_replace_radius(rel, r_ref)));
   o += fmt::format(
       "# Cells per smallest sphere radius of Yade's grid integration of the union\n"
       "# (appendClumped, replaceByClumps): 20, or fewer so that the clump's longest side has\n"
