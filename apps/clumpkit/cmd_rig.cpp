@@ -27,6 +27,8 @@ struct RigArgs {
   long rays = 20000;
   double checkpoint_interval = 60.0;
   std::string bed_from;
+  std::string engine = "clumpkit";
+  int np = 1;
 };
 
 // --bed-from: only for the discharge rig, a folder holding every repeat's bed (whether a bed fits
@@ -97,6 +99,16 @@ Command setup_rig(CLI::App& parent) {
                 "discharge: turn the beds of an earlier run (its --out folder) at this run's "
                 "rpm instead of filling the hopper again, as the paper turned one bed at 10, 15 "
                 "and 30 rpm (same model, scale, seeds; the earlier run needs --out)");
+  c->add_option("--engine", a->engine,
+                "clumpkit (the bundled runner) | liggghts: bulk_density and angle_of_repose "
+                "written as a LIGGGHTS 3.8 deck (the same walls, templates, laws and procedure) "
+                "and run there, for runs that outgrow one machine; the deck stays in "
+                "--out/repeat_K/liggghts/")
+      ->check(CLI::IsMember({"clumpkit", "liggghts"}))
+      ->capture_default_str();
+  c->add_option("--np", a->np, "--engine liggghts: MPI ranks (mpirun -np N; 1 = no mpirun)")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
   c->add_flag("--list", a->list, "List the rigs, their quantities, settings and the effects");
   c->add_option("--write-meshes", a->meshes,
                 "Write the rigs' wall meshes (paper size, STL in metres) to this folder and exit");
@@ -134,6 +146,20 @@ Command setup_rig(CLI::App& parent) {
             req.rays = a->rays;
             req.checkpoint_interval = a->checkpoint_interval;
             req.bed_from = checked_bed_from(*a, info);
+            req.engine = a->engine;
+            req.liggghts_ranks = a->np;
+            if (a->np > 1 && a->engine != "liggghts")
+              throw InputError("--np", std::to_string(a->np),
+                               "MPI ranks are for --engine liggghts (clumpkit's runner uses "
+                               "--threads)");
+            if (a->engine == "liggghts" && info.name == "discharge")
+              throw InputError("--engine", "liggghts",
+                               "the discharge rig runs on clumpkit's engine only "
+                               "(bulk_density and angle_of_repose run on LIGGGHTS)");
+            if (a->engine == "liggghts" && a->vtk)
+              throw InputError("--vtk", "",
+                               "not with --engine liggghts (its dumps are in "
+                               "--out/repeat_K/liggghts/)");
             if (a->vtk && a->out.empty())
               throw InputError("--vtk", "", "VTK output needs --out DIR");
             // Scale parameters are checked before anything is written or the long run starts.

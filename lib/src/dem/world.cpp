@@ -27,20 +27,11 @@ TypeData make_type(const ClumpTypeSettings& t, const std::string& where, const s
   if (!(mp.mass > 0.0) || !std::isfinite(mp.mass))
     throw InputError(where, f + ".clump.mass",
                      "the clump mass must be > 0 (got " + fmt_g(mp.mass) + " kg)");
-  Eigen::Matrix3d inertia = mp.inertia_tensor;
-  if (inertia.isZero(0.0)) inertia = mp.principal_moments.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (inertia + inertia.transpose()));
-  Eigen::Vector3d moments = eig.eigenvalues();
-  Eigen::Matrix3d axes = eig.eigenvectors();
   // Keep the template's own axes when it is already diagonal (the common case): no needless
   // rotation of a symmetric template.
-  const double off = (inertia - Eigen::Matrix3d(inertia.diagonal().asDiagonal())).norm();
-  if (off <= 1e-12 * inertia.norm()) {
-    moments = inertia.diagonal();
-    axes.setIdentity();
-  } else if (axes.determinant() < 0) {
-    axes.col(2) *= -1.0;
-  }
+  const PrincipalFrame frame = principal_frame(mp);
+  const Eigen::Vector3d& moments = frame.moments;
+  const Eigen::Matrix3d& axes = frame.axes;
   if (!(moments.minCoeff() > 0.0) || !moments.allFinite())
     throw InputError(where, f + ".clump.mass.inertia_tensor",
                      "principal moments of inertia must be > 0");

@@ -1,5 +1,6 @@
 #include "clumpkit/geometry/clump_template.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "clumpkit/core/atomic_file.hpp"
@@ -86,6 +87,36 @@ Eigen::Matrix3d read_mat(const json& j, const std::string& where, const std::str
   return m;
 }
 }  // namespace
+
+PrincipalFrame principal_frame(const MassProperties& mp) {
+  Eigen::Matrix3d inertia = mp.inertia_tensor;
+  if (inertia.isZero(0.0)) inertia = mp.principal_moments.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (inertia + inertia.transpose()));
+  PrincipalFrame f{eig.eigenvalues(), eig.eigenvectors()};
+  const double off = (inertia - Eigen::Matrix3d(inertia.diagonal().asDiagonal())).norm();
+  if (off <= 1e-12 * inertia.norm()) {
+    f.moments = inertia.diagonal();
+    f.axes.setIdentity();
+  } else if (f.axes.determinant() < 0) {
+    f.axes.col(2) *= -1.0;
+  }
+  return f;
+}
+
+ClumpTemplate in_principal_frame(const ClumpTemplate& c) {
+  const PrincipalFrame f = principal_frame(c.mass);
+  const Eigen::Vector3d com = c.mass.center_of_mass;
+  ClumpTemplate out = c;
+  for (Sphere& s : out.spheres) s.center = f.axes.transpose() * (s.center - com);
+  // p_source = R p + t with p = A p' + com.
+  out.translation = c.rotation * com + c.translation;
+  out.rotation = c.rotation * f.axes;
+  out.mass.center_of_mass.setZero();
+  out.mass.inertia_tensor = f.moments.asDiagonal();
+  out.mass.principal_moments = f.moments;
+  out.mass.principal_axes.setIdentity();
+  return out;
+}
 
 json to_json(const ClumpTemplate& c) {
   json spheres = json::array();

@@ -28,11 +28,40 @@ double mean_pill_mass(const dem::World& w) {
 
 }  // namespace
 
-RepeatResult angle_of_repose(Ctx& c) {
+RepeatResult heap_result(const HeapAngle& h) {
+  const double deg = 180.0 / std::numbers::pi;
+  RepeatResult r;
+  r.values["angle"] = h.angle;
+  r.values["angle_left"] = h.angle_left;
+  r.values["angle_right"] = h.angle_right;
+  nlohmann::json views = nlohmann::json::array();
+  for (const auto& v : h.views)
+    views.push_back({{"azimuth_deg", v.azimuth * deg},
+                     {"left_deg", v.left.angle * deg},
+                     {"right_deg", v.right.angle * deg},
+                     {"left_rms_m", v.left.rms},
+                     {"right_rms_m", v.right.rms}});
+  r.details = {{"fit_window", {h.window_low, h.window_high}},
+               {"angle_deg", h.angle * deg},
+               {"angle_std_over_flanks_deg", h.angle_std * deg},
+               {"angle_alt_window_deg", h.alt_angle * deg},
+               {"alt_window", {0.3, 0.7}},
+               {"window_sensitivity_deg", std::abs(h.angle - h.alt_angle) * deg},
+               {"height_over_radius_angle_deg", h.height_over_radius_angle * deg},
+               {"heap_height_m", h.height},
+               {"heap_base_radius_m", h.base_radius},
+               {"max_fit_rms_m", h.max_rms},
+               {"views", views}};
+  return r;
+}
+
+AngleOfReposeScene angle_of_repose_scene(const Ctx& c) {
   const ScaleParams& p = c.p;
+  AngleOfReposeScene a;
+  a.c = &c;
   const std::string plate_material =
       c.req.settings.count("plate") ? c.req.settings.at("plate") : "galvanized_steel";
-  LiftingGeometry g;
+  LiftingGeometry& g = a.g;
   g.inner_diameter = p.tube_diameter;
   g.height = p.tube_height;
   g.plate_side = p.plate_side;
@@ -46,20 +75,16 @@ RepeatResult angle_of_repose(Ctx& c) {
                     "cylinder (at most {:.3f} kg)",
                     p.heap_mass, p.name, 1e3 * p.tube_diameter, 1e3 * g.height, capacity));
   const std::vector<std::string> mats = {"abs_plastic", plate_material};
-  dem::WorldSettings ws = base_settings(c, mats);
+  dem::WorldSettings& ws = a.ws;
+  ws = base_settings(c, mats);
   ws.source = "angle_of_repose rig";
   ws.walls.push_back({"plate", plate_mesh(g), plate_material, {}, {}});
-  auto tube = [&](double t_on, double t_off) {
-    dem::WallSettings s{"tube", lifting_cylinder_mesh(g), "abs_plastic", {}, {}};
-    s.motion.translation = step_velocity(t_on, t_off, Vector3d(0, 0, p.lift_speed));
-    return s;
-  };
-  ws.walls.push_back(tube(1e9, 1e9 + 1));
+  ws.walls.push_back(a.tube(1e9, 1e9 + 1));
   // The factory: the tube's column, all at once when it holds the mass at a loose 20 % solid
   // fraction, else at a rate (0.3 kg/s: the column empties downwards as it is refilled). The
   // paper's D 60 × H 20 mm region above the top at the paper's slow pour would spend most of the
   // run pouring, and cannot keep up at the faster rates (the factory reported falling behind).
-  const double br = max_bound_radius(c);
+  a.br = max_bound_radius(c);
   const dem::CylinderRegion column{Vector3d(0, 0, 0.002), R - 0.001, g.height - 0.004};
   const dem::Region region = column;
   dem::FactorySettings fill = pour(c, region, p.heap_mass);
@@ -69,24 +94,44 @@ RepeatResult angle_of_repose(Ctx& c) {
   // less than a quarter of its share ends the column fill; the top-up pours the rest from above.
   fill.end_below = 0.25;
   ws.factories.push_back(fill);
+  a.tube_wall = int(ws.walls.size()) - 1;
+  return a;
+}
 
-  // When the column holds less than the mass asked (paper scale: 0.5 kg in the 0.51 L tube needs
-  // a solid fraction of 0.71 at the pills' density, more than a poured bed reaches), the rest is
-  // poured as the paper does, from its D 60 × H 20 mm region 5 mm above the top (scaled with the
-  // tube), once the column is full; what does not fit runs over the rim onto the plate. The
-  // top-up is a second factory added when the column has settled; the state names it, so a
+dem::WallSettings AngleOfReposeScene::tube(double t_on, double t_off) const {
+  dem::WallSettings s{"tube", lifting_cylinder_mesh(g), "abs_plastic", {}, {}};
+  s.motion.translation = step_velocity(t_on, t_off, Vector3d(0, 0, c->p.lift_speed));
+  return s;
+}
+
+// When the column holds less than the mass asked (paper scale: 0.5 kg in the 0.51 L tube needs
+// a solid fraction of 0.71 at the pills' density, more than a poured bed reaches), the rest is
+// poured as the paper does, from its D 60 × H 20 mm region 5 mm above the top (scaled with the
+// tube), once the column is full; what does not fit runs over the rim onto the plate.
+dem::FactorySettings AngleOfReposeScene::top_up(double t_start, double mass) const {
+  const double R = 0.5 * g.inner_diameter;
+  const double rt = R * 60.0 / 65.7;
+  dem::FactorySettings f =
+      pour(*c, dem::CylinderRegion{Vector3d(0, 0, g.height + 0.005), rt, 0.020}, mass);
+  f.name = "top-up";
+  f.rate = std::max(f.rate, 0.3);
+  f.start_time = t_start;
+  f.whole_in_region = false;  // by centre: the region holds few whole pills
+  return f;
+}
+
+RepeatResult angle_of_repose(Ctx& c) {
+  const ScaleParams& p = c.p;
+  AngleOfReposeScene a = angle_of_repose_scene(c);
+  dem::WorldSettings& ws = a.ws;
+  const LiftingGeometry& g = a.g;
+  const double R = 0.5 * p.tube_diameter;
+  const double br = a.br;
+  auto tube = [&](double t_on, double t_off) { return a.tube(t_on, t_off); };
+  // The top-up is a second factory added when the column has settled; the state names it, so a
   // resumed run creates it again.
-  auto top_up = [&](double t_start, double mass) {
-    const double rt = R * 60.0 / 65.7;
-    dem::FactorySettings f =
-        pour(c, dem::CylinderRegion{Vector3d(0, 0, g.height + 0.005), rt, 0.020}, mass);
-    f.name = "top-up";
-    f.rate = std::max(f.rate, 0.3);
-    f.start_time = t_start;
-    f.whole_in_region = false;  // by centre: the region holds few whole pills
-    return f;
-  };
-  const int tube_wall = int(ws.walls.size()) - 1;
+  auto top_up = [&](double t_start, double mass) { return a.top_up(t_start, mass); };
+  const int tube_wall = a.tube_wall;
   // Pills that roll off the plate have left the rig.
   c.outside = [](const Vector3d& x) { return x.z() < -0.02; };
 
@@ -191,29 +236,8 @@ RepeatResult angle_of_repose(Ctx& c) {
 
   const Spheres spheres = world_spheres(w);
   const HeapAngle h = measure_heap_angle(spheres);
-  const double deg = 180.0 / std::numbers::pi;
-  RepeatResult r;
-  r.values["angle"] = h.angle;
-  r.values["angle_left"] = h.angle_left;
-  r.values["angle_right"] = h.angle_right;
-  nlohmann::json views = nlohmann::json::array();
-  for (const auto& v : h.views)
-    views.push_back({{"azimuth_deg", v.azimuth * deg},
-                     {"left_deg", v.left.angle * deg},
-                     {"right_deg", v.right.angle * deg},
-                     {"left_rms_m", v.left.rms},
-                     {"right_rms_m", v.right.rms}});
-  r.details = {{"fit_window", {h.window_low, h.window_high}},
-               {"angle_deg", h.angle * deg},
-               {"angle_std_over_flanks_deg", h.angle_std * deg},
-               {"angle_alt_window_deg", h.alt_angle * deg},
-               {"alt_window", {0.3, 0.7}},
-               {"window_sensitivity_deg", std::abs(h.angle - h.alt_angle) * deg},
-               {"height_over_radius_angle_deg", h.height_over_radius_angle * deg},
-               {"heap_height_m", h.height},
-               {"heap_base_radius_m", h.base_radius},
-               {"max_fit_rms_m", h.max_rms},
-               {"views", views},
+  RepeatResult r = heap_result(h);
+  r.details.update(nlohmann::json{
                {"pills", w.clump_count()},
                {"mass_kg", w.total_mass()},
                {"lift_m", lift},
@@ -224,7 +248,7 @@ RepeatResult angle_of_repose(Ctx& c) {
                {"simulated_time_s", w.time()},
                {"time_step_s", w.dt()},
                {"pinched", pinch_json(c, w)},
-               {"profile", profile_json(c, w, c.meter.sphere_steps)}};
+               {"profile", profile_json(c, w, c.meter.sphere_steps)}});
   if (!c.dir.empty()) heap_picture(c.dir / "heap.png", spheres, h);
   return r;
 }

@@ -15,19 +15,20 @@ namespace clumpkit::rigs::detail {
 
 using Eigen::Vector3d;
 
-RepeatResult bulk_density(Ctx& c) {
+BulkDensityScene bulk_density_scene(const Ctx& c) {
   const ScaleParams& p = c.p;
+  BulkDensityScene b;
   const std::string cup_material =
       c.req.settings.count("wall") ? c.req.settings.at("wall") : "organic_glass";
-  CupGeometry cup;
-  cup.inner_diameter = p.cup_diameter;
-  cup.height = p.cup_height;
+  b.cup.inner_diameter = p.cup_diameter;
+  b.cup.height = p.cup_height;
   const double R = 0.5 * p.cup_diameter, H = p.cup_height;
   const std::vector<std::string> mats = {cup_material, "galvanized_steel"};
 
-  dem::WorldSettings ws = base_settings(c, mats);
+  dem::WorldSettings& ws = b.ws;
+  ws = base_settings(c, mats);
   ws.source = "bulk_density rig";
-  ws.walls.push_back({"cup", cup_mesh(cup), cup_material, {}, {}});
+  ws.walls.push_back({"cup", cup_mesh(b.cup), cup_material, {}, {}});
   ws.walls.push_back({"catch",
                       dem::make_plane(Vector3d(0, 0, -0.005), Vector3d::UnitZ(), 0.5, 0.5),
                       "galvanized_steel",
@@ -35,33 +36,60 @@ RepeatResult bulk_density(Ctx& c) {
                       {}});
   // Pour until overflow: 0.66 of the pills' own density fills the cup with margin (no pill
   // packs that densely), from a factory 5 mm above the rim (paper: D 20 mm × H 20 mm).
-  const double pour_mass = 0.66 * mean_union_density(c) * cup.volume();
+  b.pour_mass = 0.66 * mean_union_density(c) * b.cup.volume();
   const double fr = p.name == "paper" ? 0.010 : 0.35 * p.cup_diameter;
   const double fh = p.name == "paper" ? 0.020 : 0.6 * p.cup_height;
   ws.factories.push_back(
-      pour(c, dem::CylinderRegion{Vector3d(0, 0, H + 0.005), fr, fh}, pour_mass));
+      pour(c, dem::CylinderRegion{Vector3d(0, 0, H + 0.005), fr, fh}, b.pour_mass));
   ws.factories.back().whole_in_region = p.pour_whole_in_region;
   // The scraper waits beside the cup; phase 2 moves it across the rim.
-  const double x_start = -(R + 0.012), x_end = R + 0.02;
+  b.x_start = -(R + 0.012), b.x_end = R + 0.02;
   // The blade clears the rim by a whole pill (its bounding-sphere diameter): a pill lying across
   // the rim cannot be wedged between blade and rim. Blades one sphere diameter (or less) above
   // the rim wedged such pills and the engine stopped with overlaps of 50-85 % of a radius.
   // Pills are weighed by their centre, so what the blade leaves above the rim is not counted.
-  const double clearance = 2.0 * max_bound_radius(c);
-  auto scraper = [&](double t_on) {
-    dem::WallSettings s{
-        "scraper", scraper_mesh(x_start, R + 0.02, H + clearance, 0.06), cup_material, {}, {}};
-    // The blade leans back 45° (its face looks forward and up, as a grader's): the pills it meets
-    // are lifted over the pile instead of being driven into the bed, where a vertical blade
-    // jammed them (the engine stopped with 67-81 % overlaps).
-    for (Vector3d& v : s.mesh.vertices) v.x() -= v.z() - (H + clearance);
-    s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / p.scraper_speed,
-                                         Vector3d(p.scraper_speed, 0, 0));
-    return s;
-  };
+  b.clearance = 2.0 * max_bound_radius(c);
+  b.scraper_speed = p.scraper_speed;
+  b.scraper_material = cup_material;
+  ws.walls.push_back(b.scraper(1e9));
+  b.scraper_wall = int(ws.walls.size()) - 1;
+  return b;
+}
 
-  ws.walls.push_back(scraper(1e9));
-  const int scraper_wall = int(ws.walls.size()) - 1;
+dem::WallSettings BulkDensityScene::scraper(double t_on) const {
+  const double R = 0.5 * cup.inner_diameter, H = cup.height;
+  dem::WallSettings s{
+      "scraper", scraper_mesh(x_start, R + 0.02, H + clearance, 0.06), scraper_material, {}, {}};
+  // The blade leans back 45° (its face looks forward and up, as a grader's): the pills it meets
+  // are lifted over the pile instead of being driven into the bed, where a vertical blade
+  // jammed them (the engine stopped with 67-81 % overlaps).
+  for (Vector3d& v : s.mesh.vertices) v.x() -= v.z() - (H + clearance);
+  s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / scraper_speed,
+                                       Vector3d(scraper_speed, 0, 0));
+  return s;
+}
+
+CupWeight weigh_cup(const std::vector<Vector3d>& centres, const std::vector<double>& masses,
+                    const CupGeometry& cup) {
+  CupWeight w;
+  const double R = 0.5 * cup.inner_diameter, H = cup.height;
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Vector3d& x = centres[i];
+    if (x.head<2>().norm() < R && x.z() > 0 && x.z() < H) w.mass += masses[i], ++w.pills;
+  }
+  return w;
+}
+
+RepeatResult bulk_density(Ctx& c) {
+  const ScaleParams& p = c.p;
+  BulkDensityScene b = bulk_density_scene(c);
+  const dem::WorldSettings& ws = b.ws;
+  const CupGeometry& cup = b.cup;
+  const double R = 0.5 * p.cup_diameter, H = p.cup_height;
+  const double x_start = b.x_start, x_end = b.x_end, clearance = b.clearance;
+  const double pour_mass = b.pour_mass;
+  const int scraper_wall = b.scraper_wall;
+  auto scraper = [&](double t_on) { return b.scraper(t_on); };
   // Pills that fell past the rim onto the catch plate no longer matter: removed as they land.
   c.outside = [](const Vector3d& x) { return x.z() < 0.0; };
 
@@ -93,12 +121,11 @@ RepeatResult bulk_density(Ctx& c) {
   const SettleInfo s2 = settle(c, w, 2, state, "after strike-off");
   snapshot(c, w, "scraped");
 
-  double mass = 0;
-  long n = 0;
-  for (int i = 0; i < w.clump_count(); ++i) {
-    const Vector3d& x = w.positions()[i];
-    if (x.head<2>().norm() < R && x.z() > 0 && x.z() < H) mass += w.clump_mass(i), ++n;
-  }
+  std::vector<double> masses;
+  for (int i = 0; i < w.clump_count(); ++i) masses.push_back(w.clump_mass(i));
+  const CupWeight weight = weigh_cup(w.positions(), masses, cup);
+  const double mass = weight.mass;
+  const long n = weight.pills;
   RepeatResult r;
   r.values["bulk_density"] = mass / cup.volume();
   r.details = {{"mass_kg", mass},

@@ -18,6 +18,8 @@
 
 #include "clumpkit/dem/world.hpp"
 #include "clumpkit/geometry/sphere.hpp"
+#include "clumpkit/rigs/geometry.hpp"
+#include "clumpkit/rigs/heap_angle.hpp"
 #include "clumpkit/rigs/rig.hpp"
 
 namespace clumpkit::rigs::detail {
@@ -71,6 +73,51 @@ struct Ctx {
 RepeatResult bulk_density(Ctx& c);
 RepeatResult angle_of_repose(Ctx& c);
 RepeatResult discharge(Ctx& c);
+/// The same procedures written as a LIGGGHTS deck and run there (liggghts_rigs.cpp): bulk
+/// density and angle of repose.
+RepeatResult liggghts_repeat(Ctx& c);
+
+/// The bulk-density rig's scene, shared by both engines: the cup, the catch plate below it, the
+/// pour above the rim and the scraper waiting beside the cup (wall `scraper_wall`, at rest).
+struct BulkDensityScene {
+  CupGeometry cup;
+  dem::WorldSettings ws;
+  int scraper_wall = -1;
+  double pour_mass = 0.0;                ///< kg
+  double x_start = 0.0, x_end = 0.0;     ///< m, the blade's travel along x
+  double clearance = 0.0;                ///< m, blade above the rim
+  double scraper_speed = 0.0;            ///< m/s
+  std::string scraper_material;
+  /// The scraper moving from x_start to x_end from `t_on` (s).
+  dem::WallSettings scraper(double t_on) const;
+};
+BulkDensityScene bulk_density_scene(const Ctx& c);
+/// What the cup holds: the clumps whose centre lies inside it (as the lab weighs it after the
+/// strike-off).
+struct CupWeight {
+  double mass = 0.0;  ///< kg
+  long pills = 0;
+};
+CupWeight weigh_cup(const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& masses,
+                    const CupGeometry& cup);
+
+/// The angle-of-repose rig's scene, shared by both engines: the plate, the tube standing on it
+/// (wall `tube_wall`, at rest) and the column fill.
+struct AngleOfReposeScene {
+  const Ctx* c = nullptr;
+  LiftingGeometry g;
+  dem::WorldSettings ws;
+  int tube_wall = -1;
+  double br = 0.0;  ///< m, the pills' largest bounding radius
+  /// The tube rising at the lift speed from t_on to t_off (s).
+  dem::WallSettings tube(double t_on, double t_off) const;
+  /// The pour from above the tube's top of what the column could not hold.
+  dem::FactorySettings top_up(double t_start, double mass) const;
+};
+/// Throws InputError when the tube cannot hold the scale's heap mass.
+AngleOfReposeScene angle_of_repose_scene(const Ctx& c);
+/// The angle-of-repose observables of a measured heap, and the measurement's details.
+RepeatResult heap_result(const HeapAngle& h);
 
 /// The engine settings every rig starts from: the model's materials (stiffness scaled by the
 /// scale), clump types and contact laws against `wall_materials`, the scale's step and damping.

@@ -207,6 +207,12 @@ RigResult run_rig(const RigRequest& req) {
   res.params = rig_scale(req.rig, req.settings);
   if (req.adjust) req.adjust(res.params);
   res.scale = res.params.name;
+  if (req.engine != "clumpkit" && req.engine != "liggghts")
+    throw InputError("--engine", req.engine, "unknown engine (known: clumpkit, liggghts)");
+  if (req.engine == "liggghts" && info.name == "discharge")
+    throw InputError("--engine", "liggghts",
+                     "the discharge rig runs on clumpkit's engine only (bulk_density and "
+                     "angle_of_repose run on LIGGGHTS)");
   Ctx proto{req, res.params, {}, {}, 1, 0};
   if (req.progress) req.progress("building clump templates: " + req.model.summary());
   proto.types = req.model.clump_types(req.rays);
@@ -236,7 +242,9 @@ RigResult run_rig(const RigRequest& req) {
     const auto t_start = Clock::now();
     RepeatResult r;
     try {
-      if (info.name == "bulk_density")
+      if (req.engine == "liggghts")
+        r = detail::liggghts_repeat(c);
+      else if (info.name == "bulk_density")
         r = detail::bulk_density(c);
       else if (info.name == "angle_of_repose")
         r = detail::angle_of_repose(c);

@@ -42,6 +42,20 @@ struct ClumpTemplate {
 ClumpTemplate make_clump_template(const Spheres& source_spheres, double density,
                                   const RaySamplingOptions& sampling = {});
 
+/// The principal frame the DEM engine integrates a clump in: the eigenvectors of the inertia
+/// tensor about the centre of mass (right-handed), or the template's own axes when its tensor is
+/// already diagonal (no needless rotation of a symmetric template). An all-zero tensor stands for
+/// diag(principal_moments).
+struct PrincipalFrame {
+  Eigen::Vector3d moments = Eigen::Vector3d::Zero();       ///< kg m^2
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();      ///< columns: the axes
+};
+PrincipalFrame principal_frame(const MassProperties& mp);
+/// The template moved into that frame (spheres relative to the centre of mass along the axes;
+/// centre of mass at the origin, tensor diagonal), as DEM codes that take a template in its
+/// centroid-principal frame (LIGGGHTS) need it.
+ClumpTemplate in_principal_frame(const ClumpTemplate& c);
+
 nlohmann::json to_json(const ClumpTemplate& c);
 /// Throws InputError naming `where` and the field on a malformed template.
 ClumpTemplate clump_from_json(const nlohmann::json& j, const std::string& where);

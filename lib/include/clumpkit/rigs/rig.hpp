@@ -91,6 +91,11 @@ struct RigRequest {
   /// discharge only: keep each repeat's bed in `out` (repeat_K/bed/, the size of a checkpoint) for
   /// a later run's bed_from. The calibration's rig runs do not (their cache would double).
   bool keep_bed = true;
+  /// "clumpkit" (the bundled runner) or "liggghts": the rig written as a LIGGGHTS 3.8 deck and
+  /// run there (bulk_density and angle_of_repose), for runs that outgrow one machine. Each
+  /// repeat's deck, meshes and templates stay in `out`/repeat_K/liggghts/.
+  std::string engine = "clumpkit";
+  int liggghts_ranks = 1;  ///< MPI ranks of a LIGGGHTS run (mpirun -np); 1 = no mpirun
   std::function<void(const std::string&)> progress;  ///< one line per call, may be empty
   /// s of wall-clock time between the progress lines of the long loops (pour, settle, strike-off,
   /// lift, discharge); 0 = one line per check (tests that stop a run at a given check).

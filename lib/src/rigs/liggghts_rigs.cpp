@@ -1,0 +1,226 @@
+// The rigs on LIGGGHTS (`clumpkit rig ... --engine liggghts [--np N]`): the same scene as the
+// bundled runner's (bulk_density_scene, angle_of_repose_scene), the same procedure as script
+// loops (pour, settle by the speed criterion, the action, settle), and the same measurement on
+// what LIGGGHTS wrote (weigh_cup, measure_heap_angle).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "clumpkit/core/atomic_file.hpp"
+#include "clumpkit/core/error.hpp"
+#include "clumpkit/rigs/pictures.hpp"
+#include "liggghts_deck.hpp"
+#include "procedure.hpp"
+
+namespace clumpkit::rigs::detail {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+namespace {
+
+// The bundled runner's explicit time step for these settings (LIGGGHTS has no implicit
+// damping, so the step must keep the stiffest contact's damping explicit-stable).
+double explicit_time_step(const dem::WorldSettings& ws) {
+  dem::WorldSettings s = ws;
+  s.implicit_damping = 0.0;
+  s.threads = 1;
+  return dem::World::create(s).dt();
+}
+
+double lightest_pill(const dem::WorldSettings& ws) {
+  double m = 0;
+  for (const auto& t : ws.clump_types)
+    m = m == 0 ? t.clump.mass.mass : std::min(m, t.clump.mass.mass);
+  return m;
+}
+
+Eigen::AlignedBox3d walls_box(const dem::WorldSettings& ws) {
+  Eigen::AlignedBox3d box;
+  for (const auto& w : ws.walls)
+    for (const Vector3d& v : w.mesh.vertices) box.extend(v);
+  return box;
+}
+
+void extend(Eigen::AlignedBox3d& box, const dem::Region& r) {
+  if (const auto* c = std::get_if<dem::CylinderRegion>(&r)) {
+    box.extend(c->base_center - Vector3d(c->radius, c->radius, 0));
+    box.extend(c->base_center + Vector3d(c->radius, c->radius, c->height));
+  } else {
+    box.extend(std::get<dem::BoxRegion>(r).min);
+    box.extend(std::get<dem::BoxRegion>(r).max);
+  }
+}
+
+// The folder the deck runs in: the repeat's `liggghts/`, or a temporary one removed afterwards.
+struct RunFolder {
+  fs::path dir;
+  bool temporary = false;
+  explicit RunFolder(const Ctx& c) {
+    if (!c.dir.empty()) {
+      dir = c.dir / "liggghts";
+    } else {
+      dir = fs::temp_directory_path() / fmt::format("clumpkit_liggghts_{}_{}", ::getpid(), c.seed);
+      temporary = true;
+    }
+    std::error_code ec;
+    fs::remove_all(dir, ec);  // a killed run starts its repeat again
+    fs::create_directories(dir);
+  }
+  ~RunFolder() {
+    std::error_code ec;
+    if (temporary) fs::remove_all(dir, ec);
+  }
+  RunFolder(const RunFolder&) = delete;
+  RunFolder& operator=(const RunFolder&) = delete;
+};
+
+// Writes the deck, runs it, and returns LIGGGHTS's wall time, s.
+double run_deck(Ctx& c, const LiggghtsDeck& deck, const fs::path& dir) {
+  for (const DeckFile& f : deck.files()) write_file_atomic(dir / f.name, f.content);
+  const int np = std::max(1, c.req.liggghts_ranks);
+  c.say(fmt::format("LIGGGHTS deck written to {}; running it on {} MPI rank{}", dir.string(), np,
+                    np > 1 ? "s" : ""));
+  for (const auto& n : deck.notes()) c.say("note: " + n);
+  const auto t0 = Clock::now();
+  run_liggghts(dir.string(), np, [&](const std::string& s) {
+    c.progress([&] { return "liggghts: " + s; });
+  });
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+nlohmann::json engine_json(const Ctx& c, const LiggghtsDeck& deck, const fs::path& dir,
+                           const RunFolder& folder, double seconds) {
+  return {{"engine", "liggghts"},
+          {"mpi_ranks", std::max(1, c.req.liggghts_ranks)},
+          {"deck", folder.temporary ? std::string() : (dir / "in.rig").string()},
+          {"liggghts_wall_seconds", seconds},
+          {"time_step_s", deck.dt()},
+          {"differences", deck.notes()}};
+}
+
+RepeatResult liggghts_bulk_density(Ctx& c) {
+  const ScaleParams& p = c.p;
+  BulkDensityScene b = bulk_density_scene(c);
+  const double R = 0.5 * b.cup.inner_diameter;
+  // The catch plate only needs to reach past the scraper's travel (the domain is sized on it).
+  b.ws.walls[1].mesh = dem::make_plane(Vector3d(0, 0, -0.005), Vector3d::UnitZ(),
+                                       2 * (R + 0.03), 2 * (R + 0.03));
+  Eigen::AlignedBox3d box = walls_box(b.ws);
+  for (const Vector3d& v : b.ws.walls[size_t(b.scraper_wall)].mesh.vertices)
+    box.extend(v + Vector3d(b.x_end - b.x_start, 0, 0));
+  for (const auto& f : b.ws.factories) extend(box, f.region);
+  box.min() -= Vector3d(0.005, 0.005, 0.01);
+  box.max() += Vector3d(0.005, 0.005, 0.01);
+
+  const RunFolder folder(c);
+  const fs::path& dir = folder.dir;
+  LiggghtsDeck deck(b.ws, box, 0.0, explicit_time_step(b.ws), c.seed,
+                    fmt::format("clumpkit rig bulk_density, model {}, scale {}, seed {}",
+                                c.req.model.name, p.name, c.seed));
+  deck.run(deck.insert(b.ws.factories[0]), "pour");
+  deck.finish_insertion(0.5 * lightest_pill(b.ws));
+  deck.settle("pour: settling", p.settle_speed, p.settle_max);
+  deck.line("variable top equal bound(all,zmax)");
+  deck.line("print \"clumpkit: poured, bed top (highest sphere centre) ${top} m\"");
+  deck.move_wall("scraper", Vector3d(b.scraper_speed, 0, 0));
+  deck.run((b.x_end - b.x_start) / b.scraper_speed, "strike-off");
+  deck.stop_wall("scraper");
+  deck.settle("after strike-off", p.settle_speed, p.settle_max);
+  deck.write_state("bodies.txt", "spheres.txt");
+  const double seconds = run_deck(c, deck, dir);
+
+  std::vector<Vector3d> centres;
+  std::vector<double> masses;
+  double total = 0;
+  for (const auto& row : read_dump_rows((dir / "bodies.txt").string(), 4)) {
+    centres.emplace_back(row[0], row[1], row[2]);
+    masses.push_back(row[3]);
+    total += row[3];
+  }
+  const CupWeight weight = weigh_cup(centres, masses, b.cup);
+  RepeatResult r;
+  r.values["bulk_density"] = weight.mass / b.cup.volume();
+  r.details = {{"mass_kg", weight.mass},
+               {"pills", weight.pills},
+               {"cup_volume_m3", b.cup.volume()},
+               {"poured_mass_kg", b.pour_mass},
+               {"mass_in_domain_kg", total},
+               {"blade_clearance_m", b.clearance}};
+  r.details.update(engine_json(c, deck, dir, folder, seconds));
+  return r;
+}
+
+RepeatResult liggghts_angle_of_repose(Ctx& c) {
+  const ScaleParams& p = c.p;
+  AngleOfReposeScene a = angle_of_repose_scene(c);
+  const double H = a.g.height;
+  // The tube rises by at most the bed's height (the tube's) plus a pill and 1 cm.
+  Eigen::AlignedBox3d box = walls_box(a.ws);
+  box.extend(Vector3d(0, 0, 2 * H + 2 * a.br + 0.03));
+  for (const auto& f : a.ws.factories) extend(box, f.region);
+  box.min() -= Vector3d(0.005, 0.005, 0.03);
+  box.max() += Vector3d(0.005, 0.005, 0.01);
+
+  const RunFolder folder(c);
+  const fs::path& dir = folder.dir;
+  LiggghtsDeck deck(a.ws, box, -0.02, explicit_time_step(a.ws), c.seed,
+                    fmt::format("clumpkit rig angle_of_repose, model {}, scale {}, seed {}",
+                                c.req.model.name, p.name, c.seed));
+  const dem::FactorySettings& fill = a.ws.factories[0];
+  // Half the lightest pill: the tolerance on the mass poured.
+  const double pill_mass = lightest_pill(a.ws);
+  deck.run(deck.insert(fill), "fill");
+  const std::string in_column = deck.finish_insertion(0.5 * pill_mass);
+  // What the column could not hold is poured from above its top (the paper's region), as the
+  // bundled runner does; the heap settles once, after it.
+  deck.line(fmt::format("variable short equal {}-${{{}}}", p.heap_mass, in_column));
+  const dem::FactorySettings top = a.top_up(0.0, p.heap_mass);
+  deck.begin_block();
+  deck.line("print \"clumpkit: the tube holds less than asked: pouring ${short} kg from above\"");
+  const double interval = deck.insert(top, "short") - *top.mass / top.rate;
+  deck.run(fmt::format("{:.10g}+${{short}}/{:.10g}", interval, top.rate), "top-up");
+  deck.finish_insertion(0.5 * pill_mass);
+  deck.end_block("top_up.in");
+  deck.line(fmt::format("if \"${{short}} > {}\" then \"include top_up.in\"", 0.5 * pill_mass));
+  deck.settle("fill: settling", p.settle_speed, p.settle_max);
+  deck.line("variable top equal bound(all,zmax)");
+  deck.line(fmt::format("variable lift equal ${{top}}+{}", a.br + 0.01));
+  deck.line("print \"clumpkit: filled, lifting the tube ${lift} m\"");
+  deck.move_wall("tube", Vector3d(0, 0, p.lift_speed));
+  deck.run(fmt::format("${{lift}}/{}", p.lift_speed), "lifting");
+  deck.stop_wall("tube");
+  deck.settle("heap flow", p.settle_speed, p.settle_max);
+  deck.write_state("bodies.txt", "spheres.txt");
+  const double seconds = run_deck(c, deck, dir);
+
+  Spheres spheres;
+  for (const auto& row : read_dump_rows((dir / "spheres.txt").string(), 5))
+    if (row[3] > -0.02) spheres.push_back({Vector3d(row[1], row[2], row[3]), row[4]});
+  double mass = 0;
+  long pills = 0;
+  for (const auto& row : read_dump_rows((dir / "bodies.txt").string(), 4))
+    if (row[2] > -0.02) mass += row[3], ++pills;
+  const HeapAngle h = measure_heap_angle(spheres);
+  RepeatResult r = heap_result(h);
+  r.details.update(nlohmann::json{{"pills", pills}, {"mass_kg", mass}, {"lift_stop", "full lift"}});
+  r.details.update(engine_json(c, deck, dir, folder, seconds));
+  if (!c.dir.empty()) heap_picture(c.dir / "heap.png", spheres, h);
+  return r;
+}
+
+}  // namespace
+
+RepeatResult liggghts_repeat(Ctx& c) {
+  if (c.req.rig == "bulk_density") return liggghts_bulk_density(c);
+  if (c.req.rig == "angle_of_repose") return liggghts_angle_of_repose(c);
+  throw InputError("--engine", "liggghts",
+                   "the " + c.req.rig +
+                       " rig runs on clumpkit's engine only (bulk_density and angle_of_repose "
+                       "run on LIGGGHTS)");
+}
+
+}  // namespace clumpkit::rigs::detail
