@@ -456,7 +456,7 @@ void run_liggghts(const std::string& dir, int np,
                        "mpirun is not installed (Debian: apt-get install openmpi-bin)");
     // OpenMPI refuses root without the flag; containers often forbid its shared-memory single
     // copy (ptrace), which it then reports as an error in every exchange.
-    cmd = fmt::format("OMPI_MCA_btl_vader_single_copy_mechanism=none {} {}--oversubscribe -np {} {}",
+    cmd = fmt::format("env OMPI_MCA_btl_vader_single_copy_mechanism=none {} {}--oversubscribe -np {} {}",
                       shell_quote(mpirun), ::geteuid() == 0 ? "--allow-run-as-root " : "", np, cmd);
   }
   const std::string full = "cd " + shell_quote(dir) + " && exec " + cmd + " 2>&1";
