@@ -25,7 +25,8 @@ using Eigen::Vector3d;
 // An asymmetric two-sphere clump: its centre of mass is off the spheres' origin and its axes
 // are turned, as the rigs' ray-sampled templates are (slightly).
 dem::ClumpTypeSettings two_sphere_type(const std::string& name) {
-  const Spheres s = {{Vector3d(0.001, 0.0005, 0.0002), 0.002}, {Vector3d(-0.0012, 0.0, 0.0007), 0.0015}};
+  const Spheres s = {{Vector3d(0.001, 0.0005, 0.0002), 0.002},
+                     {Vector3d(-0.0012, 0.0, 0.0007), 0.0015}};
   return {name, make_clump_template(s, 1380.0), "pill"};
 }
 
@@ -34,14 +35,22 @@ dem::WorldSettings scene(dem::RollingModel rolling) {
   ws.materials = MaterialLibrary::paper_table1();
   ws.rolling_model = rolling;
   ws.clump_types = {two_sphere_type("A"), two_sphere_type("B")};
-  ws.walls.push_back({"cup", dem::make_plane(Vector3d::Zero(), Vector3d::UnitZ(), 0.05, 0.05),
-                      "organic_glass", {}, {}});
-  ws.walls.push_back({"blade", dem::make_plane(Vector3d(-0.02, 0, 0.03), Vector3d::UnitX(), 0.04, 0.02),
-                      "galvanized_steel", {}, {}});
+  ws.walls.push_back({"cup",
+                      dem::make_plane(Vector3d::Zero(), Vector3d::UnitZ(), 0.05, 0.05),
+                      "organic_glass",
+                      {},
+                      {}});
+  ws.walls.push_back({"blade",
+                      dem::make_plane(Vector3d(-0.02, 0, 0.03), Vector3d::UnitX(), 0.04, 0.02),
+                      "galvanized_steel",
+                      {},
+                      {}});
   return ws;
 }
 
-Eigen::AlignedBox3d box() { return {Vector3d(-0.05, -0.05, -0.01), Vector3d(0.05, 0.05, 0.1)}; }
+Eigen::AlignedBox3d box() {
+  return {Vector3d(-0.05, -0.05, -0.01), Vector3d(0.05, 0.05, 0.1)};
+}
 
 std::map<std::string, std::string> by_name(const std::vector<DeckFile>& files) {
   std::map<std::string, std::string> m;
@@ -106,7 +115,8 @@ TEST(LiggghtsDeck, StandardRollingAndCohesionAreSaidOrWritten) {
   EXPECT_EQ(numbers_after(in, "coefficientFriction peratomtypepair")[3], 0.0);
   EXPECT_EQ(numbers_after(in, "coefficientRestitution peratomtypepair")[7], 1.0);
   bool said = false;
-  for (const auto& n : deck.notes()) said = said || n.find("no 'standard' model") != std::string::npos;
+  for (const auto& n : deck.notes())
+    said = said || n.find("no 'standard' model") != std::string::npos;
   EXPECT_TRUE(said);
 }
 
@@ -140,7 +150,10 @@ TEST(LiggghtsDeck, WallsTemplatesAndSeeds) {
   for (const auto& t2 : ws.clump_types) {
     const ClumpTemplate c = in_principal_frame(t2.clump);
     EXPECT_LT(c.mass.center_of_mass.norm(), 1e-15);
-    EXPECT_NEAR((c.mass.inertia_tensor - Eigen::Matrix3d(c.mass.inertia_tensor.diagonal().asDiagonal())).norm(), 0.0, 1e-25);
+    EXPECT_NEAR(
+        (c.mass.inertia_tensor - Eigen::Matrix3d(c.mass.inertia_tensor.diagonal().asDiagonal()))
+            .norm(),
+        0.0, 1e-25);
     // The same spheres in the source frame as before the move.
     const Spheres a = t2.clump.spheres_in_source_frame(), b = c.spheres_in_source_frame();
     for (size_t k = 0; k < a.size(); ++k) EXPECT_LT((a[k].center - b[k].center).norm(), 1e-15);
@@ -164,8 +177,8 @@ TEST(LiggghtsDeck, WallsTemplatesAndSeeds) {
   std::set<long> seeds;
   int count = 0;
   const std::regex seed_re(R"((?:seed |multisphere |discrete )(\d+))");
-  for (auto it = std::sregex_iterator(all.begin(), all.end(), seed_re); it != std::sregex_iterator();
-       ++it) {
+  for (auto it = std::sregex_iterator(all.begin(), all.end(), seed_re);
+       it != std::sregex_iterator(); ++it) {
     const long s = std::stol((*it)[1]);
     EXPECT_GT(s, 10000);
     for (long d = 2; d * d <= s; ++d) ASSERT_NE(s % d, 0) << s << " is not prime";
@@ -185,7 +198,8 @@ void expect_jumps_land(const std::string& text, const std::string& name) {
     if (l.rfind("label ", 0) == 0) {
       EXPECT_TRUE(labels.insert(l.substr(6)).second) << l;
     }
-    for (size_t at = l.find("jump SELF "); at != std::string::npos; at = l.find("jump SELF ", at + 1)) {
+    for (size_t at = l.find("jump SELF "); at != std::string::npos;
+         at = l.find("jump SELF ", at + 1)) {
       std::string rest = l.substr(at + 10);
       jumps.push_back(rest.substr(0, rest.find_first_of("\" ")));
     }

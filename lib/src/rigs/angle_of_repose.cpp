@@ -237,18 +237,17 @@ RepeatResult angle_of_repose(Ctx& c) {
   const Spheres spheres = world_spheres(w);
   const HeapAngle h = measure_heap_angle(spheres);
   RepeatResult r = heap_result(h);
-  r.details.update(nlohmann::json{
-               {"pills", w.clump_count()},
-               {"mass_kg", w.total_mass()},
-               {"lift_m", lift},
-               {"lift_stop", state.value("lift_stop", "full lift")},
-               {"settle_fill", state["settle_fill"]},
-               {"fill", state.value("fill", nlohmann::json::object())},
-               {"settle_heap", settle_json(s2)},
-               {"simulated_time_s", w.time()},
-               {"time_step_s", w.dt()},
-               {"pinched", pinch_json(c, w)},
-               {"profile", profile_json(c, w, c.meter.sphere_steps)}});
+  r.details.update(nlohmann::json{{"pills", w.clump_count()},
+                                  {"mass_kg", w.total_mass()},
+                                  {"lift_m", lift},
+                                  {"lift_stop", state.value("lift_stop", "full lift")},
+                                  {"settle_fill", state["settle_fill"]},
+                                  {"fill", state.value("fill", nlohmann::json::object())},
+                                  {"settle_heap", settle_json(s2)},
+                                  {"simulated_time_s", w.time()},
+                                  {"time_step_s", w.dt()},
+                                  {"pinched", pinch_json(c, w)},
+                                  {"profile", profile_json(c, w, c.meter.sphere_steps)}});
   if (!c.dir.empty()) heap_picture(c.dir / "heap.png", spheres, h);
   return r;
 }

@@ -64,8 +64,8 @@ dem::WallSettings BulkDensityScene::scraper(double t_on) const {
   // are lifted over the pile instead of being driven into the bed, where a vertical blade
   // jammed them (the engine stopped with 67-81 % overlaps).
   for (Vector3d& v : s.mesh.vertices) v.x() -= v.z() - (H + clearance);
-  s.motion.translation = step_velocity(t_on, t_on + (x_end - x_start) / scraper_speed,
-                                       Vector3d(scraper_speed, 0, 0));
+  s.motion.translation =
+      step_velocity(t_on, t_on + (x_end - x_start) / scraper_speed, Vector3d(scraper_speed, 0, 0));
   return s;
 }
 

@@ -82,8 +82,8 @@ class LiggghtsDeck {
   std::uint64_t prime_ = 10007;
   int factories_ = 0, loops_ = 0;
   size_t block_start_ = 0;
-  std::string last_target_;    // the last insertion's mass (a number or a ${variable})
-  long last_interval_ = 0;     // its batches' interval, steps (0: all at once)
+  std::string last_target_;  // the last insertion's mass (a number or a ${variable})
+  long last_interval_ = 0;   // its batches' interval, steps (0: all at once)
 };
 
 /// A LIGGGHTS dump (`dump local` of the clumps or `dump custom` of the spheres): the rows of

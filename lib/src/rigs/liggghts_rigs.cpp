@@ -86,9 +86,8 @@ double run_deck(Ctx& c, const LiggghtsDeck& deck, const fs::path& dir) {
                     np > 1 ? "s" : ""));
   for (const auto& n : deck.notes()) c.say("note: " + n);
   const auto t0 = Clock::now();
-  run_liggghts(dir.string(), np, [&](const std::string& s) {
-    c.progress([&] { return "liggghts: " + s; });
-  });
+  run_liggghts(dir.string(), np,
+               [&](const std::string& s) { c.progress([&] { return "liggghts: " + s; }); });
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
@@ -107,8 +106,8 @@ RepeatResult liggghts_bulk_density(Ctx& c) {
   BulkDensityScene b = bulk_density_scene(c);
   const double R = 0.5 * b.cup.inner_diameter;
   // The catch plate only needs to reach past the scraper's travel (the domain is sized on it).
-  b.ws.walls[1].mesh = dem::make_plane(Vector3d(0, 0, -0.005), Vector3d::UnitZ(),
-                                       2 * (R + 0.03), 2 * (R + 0.03));
+  b.ws.walls[1].mesh =
+      dem::make_plane(Vector3d(0, 0, -0.005), Vector3d::UnitZ(), 2 * (R + 0.03), 2 * (R + 0.03));
   Eigen::AlignedBox3d box = walls_box(b.ws);
   for (const Vector3d& v : b.ws.walls[size_t(b.scraper_wall)].mesh.vertices)
     box.extend(v + Vector3d(b.x_end - b.x_start, 0, 0));
@@ -144,12 +143,9 @@ RepeatResult liggghts_bulk_density(Ctx& c) {
   const CupWeight weight = weigh_cup(centres, masses, b.cup);
   RepeatResult r;
   r.values["bulk_density"] = weight.mass / b.cup.volume();
-  r.details = {{"mass_kg", weight.mass},
-               {"pills", weight.pills},
-               {"cup_volume_m3", b.cup.volume()},
-               {"poured_mass_kg", b.pour_mass},
-               {"mass_in_domain_kg", total},
-               {"blade_clearance_m", b.clearance}};
+  r.details = {{"mass_kg", weight.mass},          {"pills", weight.pills},
+               {"cup_volume_m3", b.cup.volume()}, {"poured_mass_kg", b.pour_mass},
+               {"mass_in_domain_kg", total},      {"blade_clearance_m", b.clearance}};
   r.details.update(engine_json(c, deck, dir, folder, seconds));
   return r;
 }

@@ -83,10 +83,10 @@ struct BulkDensityScene {
   CupGeometry cup;
   dem::WorldSettings ws;
   int scraper_wall = -1;
-  double pour_mass = 0.0;                ///< kg
-  double x_start = 0.0, x_end = 0.0;     ///< m, the blade's travel along x
-  double clearance = 0.0;                ///< m, blade above the rim
-  double scraper_speed = 0.0;            ///< m/s
+  double pour_mass = 0.0;             ///< kg
+  double x_start = 0.0, x_end = 0.0;  ///< m, the blade's travel along x
+  double clearance = 0.0;             ///< m, blade above the rim
+  double scraper_speed = 0.0;         ///< m/s
   std::string scraper_material;
   /// The scraper moving from x_start to x_end from `t_on` (s).
   dem::WallSettings scraper(double t_on) const;

@@ -47,8 +47,8 @@ ClumpTemplate make_clump_template(const Spheres& source_spheres, double density,
 /// already diagonal (no needless rotation of a symmetric template). An all-zero tensor stands for
 /// diag(principal_moments).
 struct PrincipalFrame {
-  Eigen::Vector3d moments = Eigen::Vector3d::Zero();       ///< kg m^2
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();      ///< columns: the axes
+  Eigen::Vector3d moments = Eigen::Vector3d::Zero();   ///< kg m^2
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< columns: the axes
 };
 PrincipalFrame principal_frame(const MassProperties& mp);
 /// The template moved into that frame (spheres relative to the centre of mass along the axes;
