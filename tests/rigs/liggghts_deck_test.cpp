@@ -11,6 +11,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/dem/world.hpp"
@@ -189,23 +190,32 @@ TEST(LiggghtsDeck, WallsTemplatesAndSeeds) {
   EXPECT_EQ(int(seeds.size()), count);
 }
 
-// Every `jump SELF L` of a file lands on a `label L` of the same file, and labels are unique.
-void expect_jumps_land(const std::string& text, const std::string& name) {
-  std::set<std::string> labels;
-  std::istringstream ss(text);
-  std::vector<std::string> jumps;
-  for (std::string l; std::getline(ss, l);) {
-    if (l.rfind("label ", 0) == 0) {
-      EXPECT_TRUE(labels.insert(l.substr(6)).second) << l;
-    }
-    for (size_t at = l.find("jump SELF "); at != std::string::npos;
-         at = l.find("jump SELF ", at + 1)) {
-      std::string rest = l.substr(at + 10);
-      jumps.push_back(rest.substr(0, rest.find_first_of("\" ")));
+// Every `jump SELF L` lands on a `label L` of the same file, every `jump FILE [L]` on a file of
+// the deck (and its label), and no file has a label twice.
+void expect_jumps_land(const std::map<std::string, std::string>& files) {
+  std::map<std::string, std::set<std::string>> labels;
+  std::vector<std::tuple<std::string, std::string, std::string>> jumps;  // from, to, label
+  for (const auto& [name, text] : files) {
+    std::istringstream ss(text);
+    for (std::string l; std::getline(ss, l);) {
+      if (l.rfind("label ", 0) == 0) {
+        EXPECT_TRUE(labels[name].insert(l.substr(6)).second) << name << ": " << l;
+      }
+      for (size_t at = l.find("jump "); at != std::string::npos; at = l.find("jump ", at + 1)) {
+        std::istringstream js(l.substr(at + 5, l.find('"', at) - at - 5));
+        std::string to, label;
+        js >> to >> label;
+        jumps.emplace_back(name, to == "SELF" ? name : to, label);
+      }
     }
   }
-  EXPECT_FALSE(jumps.empty()) << name;
-  for (const auto& j : jumps) EXPECT_TRUE(labels.count(j)) << name << ": jump to " << j;
+  EXPECT_FALSE(jumps.empty());
+  for (const auto& [from, to, label] : jumps) {
+    EXPECT_TRUE(files.count(to)) << from << ": jump to a missing file " << to;
+    if (!label.empty()) {
+      EXPECT_TRUE(labels[to].count(label)) << from << ": jump to " << to << " " << label;
+    }
+  }
 }
 
 TEST(LiggghtsDeck, ProcedureLoopsAreClosed) {
@@ -216,14 +226,16 @@ TEST(LiggghtsDeck, ProcedureLoopsAreClosed) {
   deck.move_wall("blade", Vector3d(0.04, 0, 0));
   deck.begin_block();
   deck.run("${lift}/0.03", "lifting");
-  deck.end_block("block.in");
+  deck.end_block("block.in", "${lift} > 0");
   deck.stop_wall("blade");
   deck.write_state("bodies.txt", "spheres.txt");
   const auto files = by_name(deck.files());
   const std::string& in = files.at("in.rig");
-  expect_jumps_land(in, "in.rig");
-  expect_jumps_land(files.at("block.in"), "block.in");
-  EXPECT_EQ(in.find("${lift}"), std::string::npos);  // went to the block's file
+  expect_jumps_land(files);
+  EXPECT_EQ(in.find("${lift}/0.03"), std::string::npos);  // went to the block's file
+  EXPECT_NE(in.find("if \"${lift} > 0\" then \"jump block.in\"\nlabel after_block_in\n"),
+            std::string::npos);
+  EXPECT_NE(files.at("block.in").find("jump in.rig after_block_in\n"), std::string::npos);
   // 0.1 s at 2e-5 s: 5000 steps, in chunks.
   EXPECT_NE(in.find("variable left1 equal ceil((0.1)/2e-05-1e-9)"), std::string::npos);
   EXPECT_NE(in.find("if \"${rms} < 0.01\""), std::string::npos);

@@ -358,11 +358,17 @@ void LiggghtsDeck::run(const std::string& seconds, const std::string& what) {
   line(fmt::format("if \"${{left{}}} > 0\" then \"jump SELF run{}\"", k, k));
 }
 
-void LiggghtsDeck::end_block(const std::string& name) {
+void LiggghtsDeck::end_block(const std::string& name, const std::string& condition) {
+  // LIGGGHTS cannot `include` inside an `if`: the block is a file of its own that the main
+  // script jumps to, and that jumps back to the label after the `if`.
+  const std::string back = "after_" + ident(name);
   std::string text;
   for (size_t i = block_start_; i < lines_.size(); ++i) text += lines_[i] + "\n";
+  text += "jump in.rig " + back + "\n";
   lines_.resize(block_start_);
   files_.push_back({name, text});
+  line(fmt::format("if \"{}\" then \"jump {}\"", condition, name));
+  line("label " + back);
 }
 
 void LiggghtsDeck::settle(const std::string& what, double speed, double max_seconds, double check) {

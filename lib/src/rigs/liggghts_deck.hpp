@@ -47,10 +47,11 @@ class LiggghtsDeck {
   /// `seconds` may be a script expression ("${lift}/0.03").
   void run(double seconds, const std::string& what);
   void run(const std::string& seconds, const std::string& what);
-  /// The lines added from begin_block() to end_block(name) go to the file `name` instead, for
-  /// an `if "..." then "include name"`.
+  /// The lines added from begin_block() to end_block(name, condition) run only when the
+  /// script's `condition` holds ("${short} > 0.001"): they go to the file `name`, which the
+  /// main script jumps to and which jumps back.
   void begin_block() { block_start_ = lines_.size(); }
-  void end_block(const std::string& name);
+  void end_block(const std::string& name, const std::string& condition);
   /// The rigs' settle criterion as a script loop: runs in checks `check` s apart until the RMS
   /// sphere speed stays below `speed` (m/s) for 3 checks, or `max_seconds` have passed.
   void settle(const std::string& what, double speed, double max_seconds, double check = 0.01);

@@ -180,8 +180,7 @@ RepeatResult liggghts_angle_of_repose(Ctx& c) {
   const double interval = deck.insert(top, "short") - *top.mass / top.rate;
   deck.run(fmt::format("{:.10g}+${{short}}/{:.10g}", interval, top.rate), "top-up");
   deck.finish_insertion(0.5 * pill_mass);
-  deck.end_block("top_up.in");
-  deck.line(fmt::format("if \"${{short}} > {}\" then \"include top_up.in\"", 0.5 * pill_mass));
+  deck.end_block("top_up.in", fmt::format("${{short}} > {}", 0.5 * pill_mass));
   deck.settle("fill: settling", p.settle_speed, p.settle_max);
   deck.line("variable top equal bound(all,zmax)");
   deck.line(fmt::format("variable lift equal ${{top}}+{}", a.br + 0.01));
