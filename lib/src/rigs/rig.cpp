@@ -213,6 +213,24 @@ RigResult run_rig(const RigRequest& req) {
     throw InputError("--engine", "liggghts",
                      "the discharge rig runs on clumpkit's engine only (bulk_density and "
                      "angle_of_repose run on LIGGGHTS)");
+  // A folder holds one engine's repeats: mixing them would average two codes.
+  for (int k = 0; k < req.repeats && !req.out.empty(); ++k) {
+    const fs::path done = req.out / fmt::format("repeat_{}", k + 1) / "result.json";
+    if (!path_exists(done)) continue;
+    std::string engine = "clumpkit";
+    try {
+      engine = nlohmann::json::parse(read_file(done))
+                   .at("details")
+                   .value("engine", std::string("clumpkit"));
+    } catch (const nlohmann::json::exception&) {
+      continue;  // an unreadable record is run again
+    }
+    if (engine != req.engine)
+      throw InputError("--out", req.out.string(),
+                       fmt::format("repeat {} there was run by the {} engine, this run asks for "
+                                   "{}: give another --out",
+                                   k + 1, engine, req.engine));
+  }
   Ctx proto{req, res.params, {}, {}, 1, 0};
   if (req.progress) req.progress("building clump templates: " + req.model.summary());
   proto.types = req.model.clump_types(req.rays);
