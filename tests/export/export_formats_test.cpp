@@ -7,6 +7,7 @@
 #include <map>
 #include <numbers>
 #include <regex>
+#include <set>
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/export/exporter.hpp"
@@ -152,6 +153,24 @@ TEST(ExportLiggghts, SpheresFileAndSnippetRoundTrip) {
   for (int k = 0; k < 6; ++k)
     EXPECT_DOUBLE_EQ(std::stod(after("inertia_tensor", static_cast<size_t>(k + 1))), want[k]);
   EXPECT_EQ(tok.back(), "use_density");
+  EXPECT_EQ(tok.at(4), "15485863");  // type 1's seed
+}
+
+// LIGGGHTS refuses an insertion whose templates share a seed: each --type has its own prime.
+TEST(ExportLiggghts, EachTemplateTypeHasItsOwnPrimeSeed) {
+  const ClumpTemplate& c = test::pill_template();
+  std::set<unsigned long> seeds;
+  for (int type = 1; type <= 5; ++type) {
+    const auto files =
+        render_export(c, "liggghts", {.base_name = "", .template_type = type, .atom_type = 1});
+    const std::string& snip = files.at(1).content;
+    const size_t at = snip.find("particletemplate/multisphere ");
+    ASSERT_NE(at, std::string::npos);
+    const unsigned long seed = std::stoul(snip.substr(at + 29));
+    for (unsigned long d = 2; d * d <= seed; ++d) ASSERT_NE(seed % d, 0u) << seed;
+    EXPECT_GE(seed, 15485863u);
+    EXPECT_TRUE(seeds.insert(seed).second) << "type " << type << " repeats seed " << seed;
+  }
 }
 
 TEST(ExportLammps, MoleculeFileRoundTrip) {
