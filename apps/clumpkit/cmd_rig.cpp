@@ -100,10 +100,9 @@ Command setup_rig(CLI::App& parent) {
                 "rpm instead of filling the hopper again, as the paper turned one bed at 10, 15 "
                 "and 30 rpm (same model, scale, seeds; the earlier run needs --out)");
   c->add_option("--engine", a->engine,
-                "clumpkit (the bundled runner) | liggghts: bulk_density and angle_of_repose "
-                "written as a LIGGGHTS 3.8 deck (the same walls, templates, laws and procedure) "
-                "and run there, for runs that outgrow one machine; the deck stays in "
-                "--out/repeat_K/liggghts/")
+                "clumpkit (the bundled runner) | liggghts: the rig written as a LIGGGHTS 3.8 "
+                "deck (the same walls, templates, laws and procedure) and run there, for runs "
+                "that outgrow one machine; the deck stays in --out/repeat_K/liggghts/")
       ->check(CLI::IsMember({"clumpkit", "liggghts"}))
       ->capture_default_str();
   c->add_option("--np", a->np, "--engine liggghts: MPI ranks (mpirun -np N; 1 = no mpirun)")
@@ -145,6 +144,10 @@ Command setup_rig(CLI::App& parent) {
             req.threads = a->threads;
             req.rays = a->rays;
             req.checkpoint_interval = a->checkpoint_interval;
+            if (a->engine == "liggghts" && !a->bed_from.empty())
+              throw InputError("--bed-from", a->bed_from,
+                               "not with --engine liggghts (a LIGGGHTS run fills its own "
+                               "hopper; the saved beds are the bundled runner's checkpoints)");
             req.bed_from = checked_bed_from(*a, info);
             req.engine = a->engine;
             req.liggghts_ranks = a->np;
@@ -152,10 +155,6 @@ Command setup_rig(CLI::App& parent) {
               throw InputError("--np", std::to_string(a->np),
                                "MPI ranks are for --engine liggghts (clumpkit's runner uses "
                                "--threads)");
-            if (a->engine == "liggghts" && info.name == "discharge")
-              throw InputError("--engine", "liggghts",
-                               "the discharge rig runs on clumpkit's engine only "
-                               "(bulk_density and angle_of_repose run on LIGGGHTS)");
             if (a->engine == "liggghts" && a->vtk)
               throw InputError("--vtk", "",
                                "not with --engine liggghts (its dumps are in "

@@ -228,6 +228,8 @@ TEST(LiggghtsDeck, ProcedureLoopsAreClosed) {
   deck.run("${lift}/0.03", "lifting");
   deck.end_block("block.in", "${lift} > 0");
   deck.stop_wall("blade");
+  deck.rotate_wall("cup", Vector3d(0, 0, 0.01), Vector3d::UnitY(), -30.0);
+  deck.write_bodies("event_0.txt");
   deck.write_state("bodies.txt", "spheres.txt");
   const auto files = by_name(deck.files());
   const std::string& in = files.at("in.rig");
@@ -243,6 +245,13 @@ TEST(LiggghtsDeck, ProcedureLoopsAreClosed) {
   EXPECT_NE(in.find("fix move_blade all move/mesh mesh blade linear 0.04 0 0"), std::string::npos);
   EXPECT_NE(in.find("unfix move_blade"), std::string::npos);
   EXPECT_NE(in.find("dump bodies all local 1 bodies.txt"), std::string::npos);
+  EXPECT_NE(in.find("dump bodies all local 1 event_0.txt"), std::string::npos);
+  // The body computes are defined once however many dumps follow.
+  EXPECT_EQ(in.find("compute body_x"), in.rfind("compute body_x"));
+  // A negative rpm turns about the reversed axis, at the period of |rpm|.
+  EXPECT_NE(in.find("fix move_cup all move/mesh mesh cup rotate origin 0 0 0.01 axis 0 -1 0 "
+                    "period 2\n"),
+            std::string::npos);
 }
 
 TEST(LiggghtsDeck, DumpsAreReadOrRefused) {

@@ -76,9 +76,11 @@ nlohmann::json take_bed(Ctx& c, dem::World& w) {
 
 }  // namespace
 
-RepeatResult discharge(Ctx& c) {
+DischargeScene discharge_scene(const Ctx& c) {
   const ScaleParams& p = c.p;
-  WheelGeometry g;
+  DischargeScene d;
+  d.c = &c;
+  WheelGeometry& g = d.g;
   const double s = p.wheel_scale;
   g.outer_radius *= s, g.hub_radius *= s, g.hopper_opening *= s, g.hopper_top_width *= s;
   g.hopper_height *= s;
@@ -89,29 +91,19 @@ RepeatResult discharge(Ctx& c) {
         "--set", "slice",
         fmt::format("{:.1f} mm is narrower than one pill ({:.1f} mm)", g.length * 1e3, 2e3 * br));
   const std::vector<std::string> mats = {"abs_plastic", "galvanized_steel"};
-  dem::WorldSettings ws = base_settings(c, mats);
+  dem::WorldSettings& ws = d.ws;
+  ws = base_settings(c, mats);
   ws.source = "discharge rig";
-  auto wheel = [&](double t_on) {
-    dem::WallSettings w{"wheel", wheel_mesh(g), "abs_plastic", {}, {}};
-    dem::WallRotation rot;
-    rot.axis_point = Vector3d(0, 0, g.axis_height);
-    rot.axis = Vector3d::UnitY();
-    rot.rpm = p.rpm;
-    rot.start_time = t_on;
-    w.motion.rotation = rot;
-    return w;
-  };
   ws.walls.push_back({"housing", housing_mesh(g), "galvanized_steel", {}, {}});
   ws.walls.push_back({"hopper", hopper_mesh(g), "galvanized_steel", {}, {}});
   ws.walls.push_back({"ends", end_plates_mesh(g), "galvanized_steel", {}, {}});
-  const double z_out = g.axis_height - g.outer_radius - g.housing_gap - 0.01;
+  d.z_out = g.axis_height - g.outer_radius - g.housing_gap - 0.01;
   ws.walls.push_back({"catch",
-                      dem::make_plane(Vector3d(0, 0, z_out - 0.06), Vector3d::UnitZ(), 0.6, 0.6),
+                      dem::make_plane(Vector3d(0, 0, d.z_out - 0.06), Vector3d::UnitZ(), 0.6, 0.6),
                       "galvanized_steel",
                       {},
                       {}});
-  ws.walls.push_back(wheel(1e9));
-  // Hopper capacity: the cone plus its vertical extension, at the pills' densest packing.
+  ws.walls.push_back(d.wheel(1e9));
   const double tan_a = std::tan(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
   const double hc = 0.5 * (g.hopper_top_width - g.hopper_opening) / tan_a;
   const double hopper_volume = g.length * (0.5 * (g.hopper_opening + g.hopper_top_width) * hc +
@@ -134,8 +126,103 @@ RepeatResult discharge(Ctx& c) {
   if (fill.rate > 0.0) fill.end_below = 0.25;
   ws.factories.push_back(fill);
 
-  const int wheel_wall = int(ws.walls.size()) - 1;
-  // Pills below the outlet have been discharged: removed from the World, their mass counted.
+  d.wheel_wall = int(ws.walls.size()) - 1;
+  return d;
+}
+
+dem::WallSettings DischargeScene::wheel(double t_on) const {
+  dem::WallSettings w{"wheel", wheel_mesh(g), "abs_plastic", {}, {}};
+  dem::WallRotation rot;
+  rot.axis_point = Vector3d(0, 0, g.axis_height);
+  rot.axis = Vector3d::UnitY();
+  rot.rpm = c->p.rpm;
+  rot.start_time = t_on;
+  w.motion.rotation = rot;
+  return w;
+}
+
+PocketSchedule pocket_schedule(const WheelGeometry& g, const ScaleParams& p, double t0) {
+  PocketSchedule ps;
+  ps.omega = p.rpm * 2.0 * std::numbers::pi / 60.0;  // rad/s, about +y: angles decrease
+  ps.pitch = 2.0 * std::numbers::pi / g.pockets;
+  ps.period = ps.pitch / ps.omega;
+  const double rh = g.outer_radius + g.housing_gap;
+  const double throat = std::acos(0.5 * g.hopper_opening / rh);  // right throat edge angle
+  // Pocket k lies between vanes k and k+1: angles [a_k, a_k + pitch], a_k(t) = k·pitch − ω(t−t0).
+  // It closes when its upper vane passes below the throat edge.
+  for (int k = 0; k < g.pockets; ++k) {
+    double upper = (k + 1) * ps.pitch;
+    while (upper <= throat) upper += 2.0 * std::numbers::pi;
+    while (upper > throat + 2.0 * std::numbers::pi) upper -= 2.0 * std::numbers::pi;
+    ps.pockets.push_back({t0 + (upper - throat) / ps.omega, k});
+  }
+  std::sort(ps.pockets.begin(), ps.pockets.end(),
+            [](auto& a, auto& b) { return a.t_close < b.t_close; });
+  const int need = p.pockets_skipped + p.pockets_measured;
+  while (int(ps.pockets.size()) < need) {
+    PocketSchedule::Pocket q = ps.pockets[ps.pockets.size() - g.pockets];
+    q.t_close += 2.0 * std::numbers::pi / ps.omega;
+    ps.pockets.push_back(q);
+  }
+  ps.settle_delay = 0.05 * ps.period;
+  ps.t_end = ps.pockets[need - 1].t_close + ps.settle_delay;
+  return ps;
+}
+
+double pocket_mass(const std::vector<Vector3d>& centres, const std::vector<double>& masses,
+                   const WheelGeometry& g, double lower) {
+  const double rh = g.outer_radius + g.housing_gap;
+  const double pitch = 2.0 * std::numbers::pi / g.pockets;
+  const double L = g.length;
+  double m = 0;
+  for (size_t i = 0; i < centres.size(); ++i) {
+    const Vector3d& x = centres[i];
+    const double r = std::hypot(x.x(), x.z() - g.axis_height);
+    if (r < g.hub_radius || r > rh || std::abs(x.y()) > 0.5 * L) continue;
+    double a = std::atan2(x.z() - g.axis_height, x.x()) - lower;
+    a = std::fmod(a, 2.0 * std::numbers::pi);
+    if (a < 0) a += 2.0 * std::numbers::pi;
+    if (a < pitch) m += masses[i];
+  }
+  return m;
+}
+
+RepeatResult discharge_result(const ScaleParams& p, const WheelGeometry& g,
+                              const std::vector<double>& fills, const std::vector<double>& curve_t,
+                              const std::vector<double>& curve_m) {
+  const double s = p.wheel_scale, L = g.length;
+  const double omega = p.rpm * 2.0 * std::numbers::pi / 60.0;
+  const double period = 2.0 * std::numbers::pi / g.pockets / omega;
+  double mean = 0, ss = 0;
+  for (double f : fills) mean += f / fills.size();
+  for (double f : fills) ss += (f - mean) * (f - mean);
+  const double sd = fills.size() > 1 ? std::sqrt(ss / (fills.size() - 1)) : 0.0;
+  // Extrapolation from the slice to the paper's full pocket (100 mm long, full-size wheel).
+  const double to_paper = 0.100 / L / (s * s);
+  RepeatResult r;
+  r.values["pocket_mass"] = mean * to_paper;
+  r.values["pocket_mass_cv"] = mean > 0 ? sd / mean : 0.0;
+  r.values["mass_flow"] = mean * to_paper * g.pockets * p.rpm / 60.0;
+  r.details = {{"pocket_mass_slice_kg", mean},
+               {"pocket_fills_slice_kg", fills},
+               {"slice_to_paper_factor", to_paper},
+               {"pocket_period_s", period},
+               {"pocket_volume_m3", g.pocket_volume()},
+               {"rpm", p.rpm},
+               {"discharged_mass_kg", curve_m.empty() ? 0.0 : curve_m.back()},
+               {"curve_time_s", curve_t},
+               {"curve_mass_kg", curve_m}};
+  return r;
+}
+
+RepeatResult discharge(Ctx& c) {
+  const ScaleParams& p = c.p;
+  const DischargeScene scene = discharge_scene(c);
+  const WheelGeometry& g = scene.g;
+  const dem::WorldSettings& ws = scene.ws;
+  auto wheel = [&](double t_on) { return scene.wheel(t_on); };
+  const double z_out = scene.z_out;
+  const int wheel_wall = scene.wheel_wall;
   c.outside = [z_out](const Vector3d& x) { return x.z() < z_out; };
 
   nlohmann::json state = load_state(c);
@@ -170,43 +257,19 @@ RepeatResult discharge(Ctx& c) {
   const double t0 = state.at("t_action");
   c.removed_mass = state.value("removed_kg", 0.0);
 
-  const double omega = p.rpm * 2.0 * std::numbers::pi / 60.0;  // rad/s, about +y: angles decrease
-  const double pitch = 2.0 * std::numbers::pi / g.pockets;
-  const double period = pitch / omega;
-  const double rh = g.outer_radius + g.housing_gap;
-  const double throat = std::acos(0.5 * g.hopper_opening / rh);  // right throat edge angle
-  // Pocket k lies between vanes k and k+1: angles [a_k, a_k + pitch], a_k(t) = k·pitch − ω(t−t0).
-  // It closes when its upper vane passes below the throat edge.
-  struct Pocket {
-    double t_close;
-    int k;
-  };
-  std::vector<Pocket> pockets;
-  for (int k = 0; k < g.pockets; ++k) {
-    double upper = (k + 1) * pitch;
-    while (upper <= throat) upper += 2.0 * std::numbers::pi;
-    while (upper > throat + 2.0 * std::numbers::pi) upper -= 2.0 * std::numbers::pi;
-    pockets.push_back({t0 + (upper - throat) / omega, k});
-  }
-  std::sort(pockets.begin(), pockets.end(), [](auto& a, auto& b) { return a.t_close < b.t_close; });
+  const PocketSchedule sched = pocket_schedule(g, p, t0);
+  const double omega = sched.omega, pitch = sched.pitch, period = sched.period;
+  const auto& pockets = sched.pockets;
   const int need = p.pockets_skipped + p.pockets_measured;
-  while (int(pockets.size()) < need) {
-    Pocket q = pockets[pockets.size() - g.pockets];
-    q.t_close += 2.0 * std::numbers::pi / omega;
-    pockets.push_back(q);
-  }
-  const double settle_delay = 0.05 * period;
-  const double t_end = pockets[need - 1].t_close + settle_delay;
+  const double settle_delay = sched.settle_delay;
+  const double t_end = sched.t_end;
 
-  // Progress of phase 2 lives in the state (saved with every checkpoint), so a resumed run
-  // continues the pocket count and the discharge curve.
   std::vector<double> fills = state.value("fills", std::vector<double>{});
   std::vector<double> curve_t = state.value("curve_t", std::vector<double>{});
   std::vector<double> curve_m = state.value("curve_m", std::vector<double>{});
   size_t next = state.value("next_pocket", size_t(0));
   const double sample = period / 10.0;
   double t_next_sample = state.value("t_next_sample", w.time());
-  const double L = g.length;
   while (true) {
     const double t_next_pocket = next < size_t(need) ? pockets[next].t_close + settle_delay : 1e300;
     const double target = std::min({t_end, t_next_pocket, t_next_sample});
@@ -219,16 +282,9 @@ RepeatResult discharge(Ctx& c) {
     }
     if (next < size_t(need) && w.time() >= t_next_pocket - 1e-12) {
       const double lower = pockets[next].k * pitch - omega * (w.time() - t0);
-      double m = 0;
-      for (int i = 0; i < w.clump_count(); ++i) {
-        const Vector3d& x = w.positions()[i];
-        const double r = std::hypot(x.x(), x.z() - g.axis_height);
-        if (r < g.hub_radius || r > rh || std::abs(x.y()) > 0.5 * L) continue;
-        double a = std::atan2(x.z() - g.axis_height, x.x()) - lower;
-        a = std::fmod(a, 2.0 * std::numbers::pi);
-        if (a < 0) a += 2.0 * std::numbers::pi;
-        if (a < pitch) m += w.clump_mass(i);
-      }
+      std::vector<double> masses;
+      for (int i = 0; i < w.clump_count(); ++i) masses.push_back(w.clump_mass(i));
+      const double m = pocket_mass(w.positions(), masses, g, lower);
       if (int(next) >= p.pockets_skipped) fills.push_back(m);
       c.say(fmt::format("pocket {} closed at t = {:.3f} s: {:.4f} kg in the slice", next + 1,
                         w.time(), m));
@@ -247,34 +303,16 @@ RepeatResult discharge(Ctx& c) {
   }
   snapshot(c, w, "discharged");
 
-  double mean = 0, ss = 0;
-  for (double f : fills) mean += f / fills.size();
-  for (double f : fills) ss += (f - mean) * (f - mean);
-  const double sd = fills.size() > 1 ? std::sqrt(ss / (fills.size() - 1)) : 0.0;
-  // Extrapolation from the slice to the paper's full pocket (100 mm long, full-size wheel).
-  const double to_paper = 0.100 / L / (s * s);
-  RepeatResult r;
-  r.values["pocket_mass"] = mean * to_paper;
-  r.values["pocket_mass_cv"] = mean > 0 ? sd / mean : 0.0;
-  r.values["mass_flow"] = mean * to_paper * g.pockets * p.rpm / 60.0;
-  r.details = {{"pocket_mass_slice_kg", mean},
-               {"pocket_fills_slice_kg", fills},
-               {"slice_to_paper_factor", to_paper},
-               {"pocket_period_s", period},
-               {"pocket_volume_m3", g.pocket_volume()},
-               {"rpm", p.rpm},
-               {"discharged_mass_kg", curve_m.empty() ? 0.0 : curve_m.back()},
-               {"curve_time_s", curve_t},
-               {"curve_mass_kg", curve_m},
-               {"settle_fill", state["settle_fill"]},
-               {"bed", state.value("bed", nlohmann::json::object())},
-               {"bed_from", state.value("bed_from", "")},
-               {"leaked_before_start_kg", state.value("leaked_kg", 0.0)},
-               {"pills", w.clump_count()},
-               {"simulated_time_s", w.time()},
-               {"time_step_s", w.dt()},
-               {"pinched", pinch_json(c, w)},
-               {"profile", profile_json(c, w, c.meter.sphere_steps)}};
+  RepeatResult r = discharge_result(p, g, fills, curve_t, curve_m);
+  r.details.update(nlohmann::json{{"settle_fill", state["settle_fill"]},
+                                  {"bed", state.value("bed", nlohmann::json::object())},
+                                  {"bed_from", state.value("bed_from", "")},
+                                  {"leaked_before_start_kg", state.value("leaked_kg", 0.0)},
+                                  {"pills", w.clump_count()},
+                                  {"simulated_time_s", w.time()},
+                                  {"time_step_s", w.dt()},
+                                  {"pinched", pinch_json(c, w)},
+                                  {"profile", profile_json(c, w, c.meter.sphere_steps)}});
   if (!c.dir.empty())
     curve_picture(c.dir / "discharge.png", {{fmt::format("{:g} rpm", p.rpm), curve_t, curve_m}},
                   "t s", "m kg");

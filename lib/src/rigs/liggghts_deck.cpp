@@ -330,6 +330,8 @@ std::string LiggghtsDeck::finish_insertion(double tolerance) {
     line(fmt::format("if \"${{inserted{}}} > ${{before{}}}\" then \"jump SELF batch{}\"", l, l, l));
     line(fmt::format("label inserted{}", l));
   }
+  // An insertion all at once places its clumps at the first step after the fix.
+  if (last_interval_ == 0) line("run 1");
   // What it placed, kept in a variable of its own before the fix goes.
   line(fmt::format("variable ins{}_now equal f_ins{}[2]", k, k));
   line(fmt::format("variable poured{} equal ${{ins{}_now}}", k, k));
@@ -401,16 +403,34 @@ void LiggghtsDeck::stop_wall(const std::string& name) {
   line("unfix move_" + ident(name));
 }
 
-void LiggghtsDeck::write_state(const std::string& bodies_file, const std::string& spheres_file) {
-  line("compute body_x all rigid property xcm");
-  line("compute body_m all rigid property masstotal");
+void LiggghtsDeck::rotate_wall(const std::string& name, const Vector3d& point, const Vector3d& axis,
+                               double rpm) {
+  // (+ 0.0 turns the negated axis's -0 into 0.)
+  const Vector3d a = (rpm < 0 ? -axis : axis).normalized() + Vector3d::Zero();
+  line(fmt::format(
+      "fix move_{} all move/mesh mesh {} rotate origin {} {} {} axis {} {} {} period {}",
+      ident(name), ident(name), g(point.x()), g(point.y()), g(point.z()), g(a.x()), g(a.y()),
+      g(a.z()), g(60.0 / std::abs(rpm))));
+}
+
+void LiggghtsDeck::write_bodies(const std::string& bodies_file) {
+  if (!body_computes_) {
+    line("compute body_x all rigid property xcm");
+    line("compute body_m all rigid property masstotal");
+    body_computes_ = true;
+  }
   line(fmt::format("dump bodies all local 1 {} c_body_x[1] c_body_x[2] c_body_x[3] c_body_m",
                    bodies_file));
   line("dump_modify bodies format \"%.12g %.12g %.12g %.12g\"");
+  line("run 0");
+  line("undump bodies");
+}
+
+void LiggghtsDeck::write_state(const std::string& bodies_file, const std::string& spheres_file) {
+  write_bodies(bodies_file);
   line(fmt::format("dump spheres all custom 1 {} id x y z radius", spheres_file));
   line("dump_modify spheres format \"%d %.12g %.12g %.12g %.12g\"");
   line("run 0");
-  line("undump bodies");
   line("undump spheres");
 }
 
@@ -423,6 +443,12 @@ std::vector<DeckFile> LiggghtsDeck::files() const {
 }
 
 std::vector<std::vector<double>> read_dump_rows(const std::string& path, int columns) {
+  long timestep = 0;
+  return read_dump_rows(path, columns, &timestep);
+}
+
+std::vector<std::vector<double>> read_dump_rows(const std::string& path, int columns,
+                                                long* timestep) {
   std::ifstream in(path);
   if (!in) throw InputError(path, "", "cannot read the LIGGGHTS dump (did the run finish?)");
   std::vector<std::string> lines;
@@ -432,6 +458,11 @@ std::vector<std::vector<double>> read_dump_rows(const std::string& path, int col
     if (lines[i].rfind("ITEM: TIMESTEP", 0) == 0) start = i;
   if (start + 9 > lines.size()) throw InputError(path, "", "no complete frame in the dump");
   long count = 0;
+  try {
+    *timestep = std::stol(lines[start + 1]);
+  } catch (const std::exception&) {
+    throw InputError(path, fmt::format("line {}", start + 2), "expected the time step number");
+  }
   try {
     count = std::stol(lines[start + 3]);
   } catch (const std::exception&) {

@@ -58,9 +58,15 @@ class LiggghtsDeck {
   /// Starts wall `name` moving at velocity `v` (m/s) / stops it.
   void move_wall(const std::string& name, const Eigen::Vector3d& v);
   void stop_wall(const std::string& name);
+  /// Starts wall `name` turning at `rpm` about the axis through `point` along `axis`
+  /// (right-handed; the bundled runner's WallRotation).
+  void rotate_wall(const std::string& name, const Eigen::Vector3d& point,
+                   const Eigen::Vector3d& axis, double rpm);
   /// Writes the clumps (centre of mass and mass, `bodies_file`) and the spheres (centre and
   /// radius, `spheres_file`) once, at the current step.
   void write_state(const std::string& bodies_file, const std::string& spheres_file);
+  /// Writes the clumps only (centre of mass and mass), once, at the current step.
+  void write_bodies(const std::string& bodies_file);
   void line(const std::string& l) { lines_.push_back(l); }
 
   /// The input script and every file it reads.
@@ -83,6 +89,7 @@ class LiggghtsDeck {
   std::uint64_t prime_ = 10007;
   int factories_ = 0, loops_ = 0;
   size_t block_start_ = 0;
+  bool body_computes_ = false;
   std::string last_target_;  // the last insertion's mass (a number or a ${variable})
   long last_interval_ = 0;   // its batches' interval, steps (0: all at once)
 };
@@ -90,6 +97,9 @@ class LiggghtsDeck {
 /// A LIGGGHTS dump (`dump local` of the clumps or `dump custom` of the spheres): the rows of
 /// its last frame, numbers by column. Throws InputError naming the file on a malformed dump.
 std::vector<std::vector<double>> read_dump_rows(const std::string& path, int columns);
+/// The same, and the frame's time step number (`ITEM: TIMESTEP`).
+std::vector<std::vector<double>> read_dump_rows(const std::string& path, int columns,
+                                                long* timestep);
 
 /// Runs `liggghts -in in.rig` in `dir` (under `mpirun -np np` for np > 1), passing every line
 /// the deck prints as "clumpkit: ..." to `say`; the whole screen output goes to dir/screen.txt.

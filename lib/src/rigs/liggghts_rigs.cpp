@@ -207,15 +207,117 @@ RepeatResult liggghts_angle_of_repose(Ctx& c) {
   return r;
 }
 
+RepeatResult liggghts_discharge(Ctx& c) {
+  const ScaleParams& p = c.p;
+  DischargeScene d = discharge_scene(c);
+  const WheelGeometry& g = d.g;
+  // The catch plate only needs to reach past the outlet (the domain is sized on it).
+  const double half = g.outer_radius + g.housing_gap + 0.05;
+  for (auto& w : d.ws.walls)
+    if (w.name == "catch")
+      w.mesh = dem::make_plane(Vector3d(0, 0, d.z_out - 0.06), Vector3d::UnitZ(), 2 * half,
+                               g.length + 0.01);
+  Eigen::AlignedBox3d box = walls_box(d.ws);
+  // The turning wheel sweeps its outer circle.
+  const double ro = g.outer_radius + 0.001;
+  box.extend(Vector3d(-ro, 0, g.axis_height - ro));
+  box.extend(Vector3d(ro, 0, g.axis_height + ro));
+  for (const auto& f : d.ws.factories) extend(box, f.region);
+  box.min() -= Vector3d(0.005, 0.005, 0.02);
+  box.max() += Vector3d(0.005, 0.005, 0.01);
+
+  const RunFolder folder(c);
+  const fs::path& dir = folder.dir;
+  LiggghtsDeck deck(d.ws, box, d.z_out, explicit_time_step(d.ws), c.seed,
+                    fmt::format("clumpkit rig discharge, model {}, scale {}, {} rpm, seed {}",
+                                c.req.model.name, p.name, p.rpm, c.seed));
+  const double dt = deck.dt();
+  deck.run(deck.insert(d.ws.factories[0]), "filling the hopper");
+  deck.finish_insertion(0.5 * lightest_pill(d.ws));
+  deck.settle("hopper: settling", p.settle_speed, p.settle_max);
+  // As the bundled runner: the wheel starts 10 ms after the bed has come to rest (t0); the
+  // discharged mass is sampled every tenth of a pocket period from the settle on, and each
+  // counted pocket weighed a twentieth of a period after it has closed.
+  const PocketSchedule sched = pocket_schedule(g, p, 0.0);
+  const int need = p.pockets_skipped + p.pockets_measured;
+  const double sample = sched.period / 10.0;
+  struct Event {
+    double t;    // s after t0
+    int pocket;  // -1: a sample of the discharged mass
+  };
+  std::vector<Event> events;
+  for (double t = -0.01; t <= sched.t_end + 1e-12; t += sample) events.push_back({t, -1});
+  for (int k = 0; k < need; ++k)
+    events.push_back({sched.pockets[size_t(k)].t_close + sched.settle_delay, k});
+  std::stable_sort(events.begin(), events.end(),
+                   [](const Event& a, const Event& b) { return a.t < b.t; });
+  const long start_steps = long(std::ceil(0.01 / dt - 1e-9));
+  long at = 0;  // steps after the settle
+  bool turning = false;
+  for (size_t e = 0; e < events.size(); ++e) {
+    const long to = std::max(at, long(std::ceil((events[e].t + 0.01) / dt - 1e-9)));
+    if (!turning && to >= start_steps) {
+      if (start_steps > at) deck.line(fmt::format("run {}", start_steps - at));
+      at = start_steps;
+      deck.rotate_wall("wheel", Vector3d(0, 0, g.axis_height), Vector3d::UnitY(), p.rpm);
+      turning = true;
+    }
+    if (to > at) deck.line(fmt::format("run {}", to - at));
+    at = to;
+    deck.write_bodies(fmt::format("event_{}.txt", e));
+    deck.line(fmt::format("print \"clumpkit: discharge: t = ${{now}} s, {} of {} pockets weighed\"",
+                          events[e].pocket >= 0 ? events[e].pocket + 1 : 0, need));
+  }
+  const double seconds = run_deck(c, deck, dir);
+
+  // Steps count from 0 at a constant step, so a dump's time is its step times dt.
+  long step0 = 0;
+  read_dump_rows((dir / "event_0.txt").string(), 4, &step0);
+  const double t0 = double(step0 + start_steps) * dt;
+  double up0 = 0;  // mass in the rig (centre above z_out) when the first sample was taken
+  long pills = 0;  // clumps in the rig at the last event
+  std::vector<double> fills, curve_t, curve_m;
+  for (size_t e = 0; e < events.size(); ++e) {
+    long step = 0;
+    std::vector<Vector3d> centres;
+    std::vector<double> masses;
+    double up = 0;
+    pills = 0;
+    for (const auto& row :
+         read_dump_rows((dir / fmt::format("event_{}.txt", e)).string(), 4, &step)) {
+      centres.emplace_back(row[0], row[1], row[2]);
+      masses.push_back(row[3]);
+      if (row[2] >= d.z_out) up += row[3], ++pills;
+    }
+    const double t = double(step) * dt;
+    if (e == 0) up0 = up;
+    if (events[e].pocket < 0) {
+      curve_t.push_back(t - t0);
+      curve_m.push_back(up0 - up);
+    } else {
+      const int k = sched.pockets[size_t(events[e].pocket)].k;
+      const double lower = k * sched.pitch - sched.omega * (t - t0);
+      const double m = pocket_mass(centres, masses, g, lower);
+      if (events[e].pocket >= p.pockets_skipped) fills.push_back(m);
+      c.say(fmt::format("pocket {} weighed at t = {:.3f} s: {:.4f} kg in the slice",
+                        events[e].pocket + 1, t, m));
+    }
+  }
+  RepeatResult r = discharge_result(p, g, fills, curve_t, curve_m);
+  r.details["pills"] = pills;
+  r.details.update(engine_json(c, deck, dir, folder, seconds));
+  if (!c.dir.empty())
+    curve_picture(c.dir / "discharge.png", {{fmt::format("{:g} rpm", p.rpm), curve_t, curve_m}},
+                  "t s", "m kg");
+  return r;
+}
+
 }  // namespace
 
 RepeatResult liggghts_repeat(Ctx& c) {
   if (c.req.rig == "bulk_density") return liggghts_bulk_density(c);
   if (c.req.rig == "angle_of_repose") return liggghts_angle_of_repose(c);
-  throw InputError("--engine", "liggghts",
-                   "the " + c.req.rig +
-                       " rig runs on clumpkit's engine only (bulk_density and angle_of_repose "
-                       "run on LIGGGHTS)");
+  return liggghts_discharge(c);
 }
 
 }  // namespace clumpkit::rigs::detail

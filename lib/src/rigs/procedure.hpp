@@ -119,6 +119,43 @@ AngleOfReposeScene angle_of_repose_scene(const Ctx& c);
 /// The angle-of-repose observables of a measured heap, and the measurement's details.
 RepeatResult heap_result(const HeapAngle& h);
 
+/// The discharger's scene, shared by both engines: housing, hopper, end plates, the catch plate
+/// below the outlet (clumps below `z_out` have left the rig), the wheel (wall `wheel_wall`, at
+/// rest) and the hopper fill.
+struct DischargeScene {
+  const Ctx* c = nullptr;
+  WheelGeometry g;
+  dem::WorldSettings ws;
+  int wheel_wall = -1;
+  double z_out = 0.0;  ///< m
+  /// The wheel turning at the scale's rpm from `t_on` (s).
+  dem::WallSettings wheel(double t_on) const;
+};
+/// Throws InputError for a slice narrower than a pill or a bed the hopper cannot hold.
+DischargeScene discharge_scene(const Ctx& c);
+/// When the counted pockets close, for a wheel started at t0 (s): pocket k lies between vanes k
+/// and k+1 and closes when its upper vane passes below the throat edge; it is weighed
+/// `settle_delay` later. `t_end` is when the last counted pocket is weighed.
+struct PocketSchedule {
+  double omega = 0.0, pitch = 0.0, period = 0.0;  ///< rad/s, rad, s
+  double settle_delay = 0.0, t_end = 0.0;         ///< s
+  struct Pocket {
+    double t_close;  ///< s
+    int k;
+  };
+  std::vector<Pocket> pockets;  ///< the skipped and measured pockets, in closing order
+};
+PocketSchedule pocket_schedule(const WheelGeometry& g, const ScaleParams& p, double t0);
+/// The mass of the clumps whose centre lies in the pocket whose lower vane is at angle `lower`
+/// (rad, from +x towards +z), kg.
+double pocket_mass(const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& masses,
+                   const WheelGeometry& g, double lower);
+/// The discharge observables from the counted pockets' fills (kg in the slice) and the
+/// discharged mass over time (s, kg).
+RepeatResult discharge_result(const ScaleParams& p, const WheelGeometry& g,
+                              const std::vector<double>& fills, const std::vector<double>& curve_t,
+                              const std::vector<double>& curve_m);
+
 /// The engine settings every rig starts from: the model's materials (stiffness scaled by the
 /// scale), clump types and contact laws against `wall_materials`, the scale's step and damping.
 dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& wall_materials);

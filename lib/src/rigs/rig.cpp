@@ -209,10 +209,8 @@ RigResult run_rig(const RigRequest& req) {
   res.scale = res.params.name;
   if (req.engine != "clumpkit" && req.engine != "liggghts")
     throw InputError("--engine", req.engine, "unknown engine (known: clumpkit, liggghts)");
-  if (req.engine == "liggghts" && info.name == "discharge")
-    throw InputError("--engine", "liggghts",
-                     "the discharge rig runs on clumpkit's engine only (bulk_density and "
-                     "angle_of_repose run on LIGGGHTS)");
+  if (req.engine == "liggghts" && !req.bed_from.empty())
+    throw InputError("--bed-from", req.bed_from.string(), "not with --engine liggghts");
   // A folder holds one engine's repeats: mixing them would average two codes.
   for (int k = 0; k < req.repeats && !req.out.empty(); ++k) {
     const fs::path done = req.out / fmt::format("repeat_{}", k + 1) / "result.json";

@@ -92,7 +92,7 @@ struct RigRequest {
   /// a later run's bed_from. The calibration's rig runs do not (their cache would double).
   bool keep_bed = true;
   /// "clumpkit" (the bundled runner) or "liggghts": the rig written as a LIGGGHTS 3.8 deck and
-  /// run there (bulk_density and angle_of_repose), for runs that outgrow one machine. Each
+  /// run there (every rig; not with bed_from), for runs that outgrow one machine. Each
   /// repeat's deck, meshes and templates stay in `out`/repeat_K/liggghts/.
   std::string engine = "clumpkit";
   int liggghts_ranks = 1;  ///< MPI ranks of a LIGGGHTS run (mpirun -np); 1 = no mpirun
