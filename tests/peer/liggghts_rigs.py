@@ -3,10 +3,10 @@
 
 For the bulk density, the angle of repose and the discharger, the same command runs with both
 engines: the same model (the production model with the CDT rolling model, which both codes
-have), scale, seeds and repeats. clumpkit writes the rig as a LIGGGHTS deck, runs it (the bulk density under
-`mpirun -np 2`, the others on one rank) and measures the result with the same code as its own
-runs (the cup weighed by clump centres; the heap's silhouette fit; the pockets weighed as they
-close). Checked:
+have), scale, seeds and repeats. clumpkit writes the rig as a LIGGGHTS deck, runs it (the
+bulk density under `mpirun -np N` with --np N > 1, the others on one rank) and measures the
+result with the same code as its own runs (the cup weighed by clump centres; the heap's
+silhouette fit; the pockets weighed as they close). Checked:
 
   * each LIGGGHTS repeat ran there: engine "liggghts", the MPI ranks asked, the deck kept,
     pills in the cup / on the plate / in the rig, and only the expected difference noted (no
