@@ -55,6 +55,27 @@ void extend(Eigen::AlignedBox3d& box, const dem::Region& r) {
   }
 }
 
+// The clumps of a `write_bodies` dump: centres of mass and masses (and the dump's step).
+struct Bodies {
+  std::vector<Vector3d> centres;
+  std::vector<double> masses;
+  long step = 0;
+};
+Bodies read_bodies(const fs::path& file) {
+  Bodies b;
+  for (const auto& row : read_dump_rows(file.string(), 4, &b.step)) {
+    b.centres.emplace_back(row[0], row[1], row[2]);
+    b.masses.push_back(row[3]);
+  }
+  return b;
+}
+
+// The catch plate below a rig need only reach past its outlet: the domain is sized on it.
+void shrink_catch(dem::WorldSettings& ws, const dem::TriangleMesh& plate) {
+  for (auto& w : ws.walls)
+    if (w.name == "catch") w.mesh = plate;
+}
+
 // The folder the deck runs in: the repeat's `liggghts/`, or a temporary one removed afterwards.
 struct RunFolder {
   fs::path dir;
@@ -105,9 +126,8 @@ RepeatResult liggghts_bulk_density(Ctx& c) {
   const ScaleParams& p = c.p;
   BulkDensityScene b = bulk_density_scene(c);
   const double R = 0.5 * b.cup.inner_diameter;
-  // The catch plate only needs to reach past the scraper's travel (the domain is sized on it).
-  b.ws.walls[1].mesh =
-      dem::make_plane(Vector3d(0, 0, -0.005), Vector3d::UnitZ(), 2 * (R + 0.03), 2 * (R + 0.03));
+  shrink_catch(b.ws, dem::make_plane(Vector3d(0, 0, -0.005), Vector3d::UnitZ(), 2 * (R + 0.03),
+                                     2 * (R + 0.03)));
   Eigen::AlignedBox3d box = walls_box(b.ws);
   for (const Vector3d& v : b.ws.walls[size_t(b.scraper_wall)].mesh.vertices)
     box.extend(v + Vector3d(b.x_end - b.x_start, 0, 0));
@@ -132,15 +152,10 @@ RepeatResult liggghts_bulk_density(Ctx& c) {
   deck.write_state("bodies.txt", "spheres.txt");
   const double seconds = run_deck(c, deck, dir);
 
-  std::vector<Vector3d> centres;
-  std::vector<double> masses;
+  const Bodies bodies = read_bodies(dir / "bodies.txt");
   double total = 0;
-  for (const auto& row : read_dump_rows((dir / "bodies.txt").string(), 4)) {
-    centres.emplace_back(row[0], row[1], row[2]);
-    masses.push_back(row[3]);
-    total += row[3];
-  }
-  const CupWeight weight = weigh_cup(centres, masses, b.cup);
+  for (double m : bodies.masses) total += m;
+  const CupWeight weight = weigh_cup(bodies.centres, bodies.masses, b.cup);
   RepeatResult r;
   r.values["bulk_density"] = weight.mass / b.cup.volume();
   r.details = {{"mass_kg", weight.mass},          {"pills", weight.pills},
@@ -197,8 +212,9 @@ RepeatResult liggghts_angle_of_repose(Ctx& c) {
     if (row[3] > -0.02) spheres.push_back({Vector3d(row[1], row[2], row[3]), row[4]});
   double mass = 0;
   long pills = 0;
-  for (const auto& row : read_dump_rows((dir / "bodies.txt").string(), 4))
-    if (row[2] > -0.02) mass += row[3], ++pills;
+  const Bodies bodies = read_bodies(dir / "bodies.txt");
+  for (size_t i = 0; i < bodies.masses.size(); ++i)
+    if (bodies.centres[i].z() > -0.02) mass += bodies.masses[i], ++pills;
   const HeapAngle h = measure_heap_angle(spheres);
   RepeatResult r = heap_result(h);
   r.details.update(nlohmann::json{{"pills", pills}, {"mass_kg", mass}, {"lift_stop", "full lift"}});
@@ -211,12 +227,9 @@ RepeatResult liggghts_discharge(Ctx& c) {
   const ScaleParams& p = c.p;
   DischargeScene d = discharge_scene(c);
   const WheelGeometry& g = d.g;
-  // The catch plate only needs to reach past the outlet (the domain is sized on it).
   const double half = g.outer_radius + g.housing_gap + 0.05;
-  for (auto& w : d.ws.walls)
-    if (w.name == "catch")
-      w.mesh = dem::make_plane(Vector3d(0, 0, d.z_out - 0.06), Vector3d::UnitZ(), 2 * half,
-                               g.length + 0.01);
+  shrink_catch(d.ws, dem::make_plane(Vector3d(0, 0, d.z_out - 0.06), Vector3d::UnitZ(), 2 * half,
+                                     g.length + 0.01));
   Eigen::AlignedBox3d box = walls_box(d.ws);
   // The turning wheel sweeps its outer circle.
   const double ro = g.outer_radius + 0.001;
@@ -271,24 +284,18 @@ RepeatResult liggghts_discharge(Ctx& c) {
   const double seconds = run_deck(c, deck, dir);
 
   // Steps count from 0 at a constant step, so a dump's time is its step times dt.
-  long step0 = 0;
-  read_dump_rows((dir / "event_0.txt").string(), 4, &step0);
-  const double t0 = double(step0 + start_steps) * dt;
+  double t0 = 0;   // s, the wheel's start: start_steps after the first sample
   double up0 = 0;  // mass in the rig (centre above z_out) when the first sample was taken
   long pills = 0;  // clumps in the rig at the last event
   std::vector<double> fills, curve_t, curve_m;
   for (size_t e = 0; e < events.size(); ++e) {
-    long step = 0;
-    std::vector<Vector3d> centres;
-    std::vector<double> masses;
+    const Bodies b = read_bodies(dir / fmt::format("event_{}.txt", e));
     double up = 0;
     pills = 0;
-    for (const auto& row :
-         read_dump_rows((dir / fmt::format("event_{}.txt", e)).string(), 4, &step)) {
-      centres.emplace_back(row[0], row[1], row[2]);
-      masses.push_back(row[3]);
-      if (row[2] >= d.z_out) up += row[3], ++pills;
-    }
+    for (size_t i = 0; i < b.masses.size(); ++i)
+      if (b.centres[i].z() >= d.z_out) up += b.masses[i], ++pills;
+    const long step = b.step;
+    if (e == 0) t0 = double(step + start_steps) * dt;
     const double t = double(step) * dt;
     if (e == 0) up0 = up;
     if (events[e].pocket < 0) {
@@ -297,7 +304,7 @@ RepeatResult liggghts_discharge(Ctx& c) {
     } else {
       const int k = sched.pockets[size_t(events[e].pocket)].k;
       const double lower = k * sched.pitch - sched.omega * (t - t0);
-      const double m = pocket_mass(centres, masses, g, lower);
+      const double m = pocket_mass(b.centres, b.masses, g, lower);
       if (events[e].pocket >= p.pockets_skipped) fills.push_back(m);
       c.say(fmt::format("pocket {} weighed at t = {:.3f} s: {:.4f} kg in the slice",
                         events[e].pocket + 1, t, m));
