@@ -14,6 +14,7 @@
 #include "clumpkit/calibrate/report.hpp"
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
+#include "clumpkit/rigs/rig.hpp"
 
 namespace clumpkit::cli {
 namespace {
@@ -30,6 +31,8 @@ struct CalArgs {
   bool apply = false, quiet = false, no_suggest = false, no_pairs = false;
   std::string suggest = "ambiguous";
   double noise = 0.03;
+  std::string engine = "clumpkit";
+  int np = 1;
 };
 
 void common_options(CLI::App* c, CalArgs& a) {
@@ -47,6 +50,17 @@ void common_options(CLI::App* c, CalArgs& a) {
                 "Rig runs made side by side, one engine thread each (0 = one per core at the "
                 "tiny and mini scales, 1 at small and paper)")
       ->check(CLI::Range(0, 256));
+  c->add_option("--engine", a.engine,
+                "clumpkit (the bundled runner) | liggghts: every rig run written as a LIGGGHTS "
+                "3.8 deck and run there (`clumpkit rig --engine liggghts`), for rigs that "
+                "outgrow one machine; cached apart from the bundled runner's results")
+      ->check(CLI::IsMember({"clumpkit", "liggghts"}))
+      ->capture_default_str();
+  c->add_option("--np", a.np,
+                "--engine liggghts: MPI ranks per rig run (mpirun -np N; 1 = no mpirun). "
+                "--jobs then defaults to the cores over N")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
   c->add_option("--json", a.json, "Write the result as JSON (FILE or -)");
   c->add_flag("--quiet", a.quiet, "No progress lines");
 }
@@ -55,10 +69,13 @@ RigSimulator make_sim(const CalArgs& a) {
   RigSimulator::Options o;
   o.cache_dir = a.cache;
   o.threads = a.threads;
-  o.jobs = a.jobs > 0 ? a.jobs
-           : (a.scale == "tiny" || a.scale == "mini")
-               ? std::max(1, static_cast<int>(std::thread::hardware_concurrency()))
-               : 1;
+  o.engine = a.engine;
+  o.liggghts_ranks = a.np;
+  // Side by side at the small scales: one engine thread, or one run of N MPI ranks, per core.
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  o.jobs = a.jobs > 0                                 ? a.jobs
+           : (a.scale == "tiny" || a.scale == "mini") ? std::max(1, cores / a.np)
+                                                      : 1;
   if (!a.quiet) o.progress = [](const std::string& s) { std::cerr << "clumpkit: " << s << "\n"; };
   return RigSimulator(o);
 }
@@ -134,6 +151,7 @@ Command setup_compare(CLI::App& parent) {
   c->add_option("--report", a->report, "Write a self-contained HTML report into this folder");
   common_options(c, *a);
   return {c, [a] {
+            rigs::check_engine(a->engine, a->np);
             const auto ms = load_measurements(a->measurements);  // validated before any run
             warn_redundant(ms, a->measurements);
             std::vector<ParticleModel> models;
@@ -169,6 +187,8 @@ Command setup_compare(CLI::App& parent) {
               json out = chain.back();
               out["scale"] = a->scale;
               out["repeats"] = a->repeats;
+              out["engine"] = a->engine;
+              out["mpi_ranks"] = a->engine == "liggghts" ? a->np : 0;
               if (chain.size() > 1) out["chain"] = chain;
               write_json(out, a->json);
             }
@@ -216,6 +236,7 @@ Command setup_diagnose(CLI::App& parent) {
   common_options(c, *a);
   return {
       c, [a] {
+        rigs::check_engine(a->engine, a->np);
         const auto ms = load_measurements(a->measurements);
         warn_redundant(ms, a->measurements);
         if (ms.size() < 3)
@@ -324,6 +345,8 @@ Command setup_diagnose(CLI::App& parent) {
                     {"screen_only", d.screen_only},
                     {"skipped", d.skipped},
                     {"simulations", d.simulations},
+                    {"engine", a->engine},
+                    {"mpi_ranks", a->engine == "liggghts" ? a->np : 0},
                     {"summary", d.summary()}};
         ReportInput rep;
         rep.chain.emplace_back(base.name, d.baseline);
@@ -382,6 +405,7 @@ Command setup_synth(CLI::App& parent) {
   a->repeats = 4;
   common_options(c, *a);
   return {c, [a] {
+            rigs::check_engine(a->engine, a->np);
             auto ms = load_measurements(a->measurements);
             warn_redundant(ms, a->measurements);
             const ParticleModel truth = load_model(find_model(a->models.front()), data_dir());
@@ -410,10 +434,14 @@ Command setup_synth(CLI::App& parent) {
               m.std = std::sqrt(lab * lab + m.n * se_truth * se_truth);
             }
             write_file_atomic(
-                a->output, fmt::format("# synthetic: truth model {}, noise {} relative, seed {}, "
-                                       "scale {}\n",
-                                       truth.name, a->noise, a->seed, a->scale) +
-                               format_measurements(ms));
+                a->output,
+                fmt::format("# synthetic: truth model {}, noise {} relative, seed {}, "
+                            "scale {}{}\n",
+                            truth.name, a->noise, a->seed, a->scale,
+                            a->engine == "clumpkit"
+                                ? ""
+                                : fmt::format(", engine {} ({} MPI rank(s))", a->engine, a->np)) +
+                    format_measurements(ms));
             std::cout << fmt::format("wrote {} measurements to {}\n", ms.size(), a->output);
             return 0;
           }};

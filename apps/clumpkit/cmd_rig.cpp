@@ -151,10 +151,7 @@ Command setup_rig(CLI::App& parent) {
             req.bed_from = checked_bed_from(*a, info);
             req.engine = a->engine;
             req.liggghts_ranks = a->np;
-            if (a->np > 1 && a->engine != "liggghts")
-              throw InputError("--np", std::to_string(a->np),
-                               "MPI ranks are for --engine liggghts (clumpkit's runner uses "
-                               "--threads)");
+            rigs::check_engine(a->engine, a->np);  // before the templates are built
             if (a->engine == "liggghts" && a->vtk)
               throw InputError("--vtk", "",
                                "not with --engine liggghts (its dumps are in "

@@ -106,6 +106,9 @@ RigSimulator::Entry RigSimulator::entry(const ParticleModel& model, const SimReq
   e.model = model_for_sample(model, req.sample, model.path.string());
   e.key = fmt::format("{}|{}|{}|{}|engine {} rigs {}", req.key(), seed, repeats,
                       model_fingerprint(e.model), dem::kPhysicsRevision, rigs::kRigsRevision);
+  // The bundled runner's keys are as they always were (caches stay valid); LIGGGHTS's name it.
+  if (opt_.engine != "clumpkit")
+    e.key += fmt::format("|{} np {}", opt_.engine, std::max(1, opt_.liggghts_ranks));
   const std::string id = fmt::format("{:016x}", std::hash<std::string>{}(e.key));
   e.file = opt_.cache_dir / (req.rig + "_" + id + ".json");
   e.run_dir = opt_.cache_dir / ("run_" + req.rig + "_" + id);
@@ -144,6 +147,8 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
   rr.rays = opt_.rays;
   rr.out = e.run_dir;
   rr.keep_bed = false;  // nothing turns a cached run's discharger bed again
+  rr.engine = opt_.engine;
+  rr.liggghts_ranks = opt_.liggghts_ranks;
   if (opt_.progress)
     rr.progress = [this](const std::string& s) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -154,9 +159,12 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
     // The run's number and the time since this simulator began: a diagnosis's only clock.
     const double minutes =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count() / 60.0;
-    opt_.progress(fmt::format("[rig run {}, {:.1f} min] simulating {} sample {} [{}] model {} x{}",
-                              ++started_, minutes, req.rig, req.sample,
-                              format_settings(req.settings), e.model.name, repeats));
+    opt_.progress(fmt::format(
+        "[rig run {}, {:.1f} min] simulating {} sample {} [{}] model {} x{}{}", ++started_, minutes,
+        req.rig, req.sample, format_settings(req.settings), e.model.name, repeats,
+        opt_.engine == "clumpkit" ? ""
+                                  : fmt::format(" on {} ({} MPI rank(s))", opt_.engine,
+                                                std::max(1, opt_.liggghts_ranks))));
   }
   const rigs::RigResult r = rigs::run_rig(rr);
   if (!r.error.empty())

@@ -483,21 +483,25 @@ std::vector<std::vector<double>> read_dump_rows(const std::string& path, int col
   return rows;
 }
 
-void run_liggghts(const std::string& dir, int np,
-                  const std::function<void(const std::string&)>& say) {
-  const std::string liggghts = which("liggghts");
-  if (liggghts.empty())
+void require_liggghts(int np) {
+  if (which("liggghts").empty())
     throw InputError("--engine", "liggghts",
                      "LIGGGHTS is not installed (Debian: apt-get install liggghts)");
+  if (np > 1 && which("mpirun").empty())
+    throw InputError("--np", std::to_string(np),
+                     "mpirun is not installed (Debian: apt-get install openmpi-bin)");
+}
+
+void run_liggghts(const std::string& dir, int np,
+                  const std::function<void(const std::string&)>& say) {
+  require_liggghts(np);
+  const std::string liggghts = which("liggghts");
   // Line-buffered, so progress arrives as it happens and an MPI abort loses no ERROR line.
   const std::string stdbuf = which("stdbuf");
   std::string cmd = (stdbuf.empty() ? "" : shell_quote(stdbuf) + " -oL -eL ") +
                     shell_quote(liggghts) + " -in in.rig -log liggghts.log";
   if (np > 1) {
     const std::string mpirun = which("mpirun");
-    if (mpirun.empty())
-      throw InputError("--np", std::to_string(np),
-                       "mpirun is not installed (Debian: apt-get install openmpi-bin)");
     // OpenMPI refuses root without the flag; containers often forbid its shared-memory single
     // copy (ptrace), which it then reports as an error in every exchange.
     cmd = fmt::format(

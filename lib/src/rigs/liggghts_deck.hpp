@@ -101,6 +101,9 @@ std::vector<std::vector<double>> read_dump_rows(const std::string& path, int col
 std::vector<std::vector<double>> read_dump_rows(const std::string& path, int columns,
                                                 long* timestep);
 
+/// Throws InputError when liggghts (or, for np > 1, mpirun) is not on the PATH.
+void require_liggghts(int np);
+
 /// Runs `liggghts -in in.rig` in `dir` (under `mpirun -np np` for np > 1), passing every line
 /// the deck prints as "clumpkit: ..." to `say`; the whole screen output goes to dir/screen.txt.
 /// Throws InputError when liggghts (or mpirun) is not installed, NumericalError with

@@ -31,6 +31,20 @@ double explicit_time_step(const dem::WorldSettings& ws) {
   return dem::World::create(s).dt();
 }
 
+// The mean mass of the pills a LIGGGHTS insertion of this factory's mixture places: its
+// fractions are mass fractions, so the pills come in number fractions w_i / m_i, normalised.
+// LIGGGHTS places floor(mass asked / this) of them.
+double expected_pill_mass(const dem::WorldSettings& ws, const dem::FactorySettings& f) {
+  double fractions = 0, per_kg = 0;
+  for (const auto& e : f.mixture)
+    for (const auto& t : ws.clump_types)
+      if (t.name == e.clump_type) {
+        fractions += e.mass_fraction;
+        per_kg += e.mass_fraction / t.clump.mass.mass;
+      }
+  return fractions / per_kg;
+}
+
 double lightest_pill(const dem::WorldSettings& ws) {
   double m = 0;
   for (const auto& t : ws.clump_types)
@@ -192,8 +206,18 @@ RepeatResult liggghts_angle_of_repose(Ctx& c) {
   const dem::FactorySettings top = a.top_up(0.0, p.heap_mass);
   deck.begin_block();
   deck.line("print \"clumpkit: the tube holds less than asked: pouring ${short} kg from above\"");
-  const double interval = deck.insert(top, "short") - *top.mass / top.rate;
-  deck.run(fmt::format("{:.10g}+${{short}}/{:.10g}", interval, top.rate), "top-up");
+  // LIGGGHTS places floor(mass / mean pill mass) pills, and an insertion of none stops the next
+  // run ("'start' step can not be before current step"; found with a 0.57-pill shortfall). Half
+  // a pill more places the nearest whole number of pills, and at least one.
+  const double m_pill = expected_pill_mass(a.ws, top);
+  // max(a, b) as (a + b + |a - b|) / 2: an equal-style max() is LIGGGHTS's reduction of a
+  // compute.
+  deck.line(
+      fmt::format("variable top_kg equal 0.5*((${{short}}+{0:.12g})+{1:.12g}+abs((${{short}}+"
+                  "{0:.12g})-{1:.12g}))",
+                  0.5 * m_pill, m_pill * (1 + 1e-6)));
+  const double interval = deck.insert(top, "top_kg") - *top.mass / top.rate;
+  deck.run(fmt::format("{:.10g}+${{top_kg}}/{:.10g}", interval, top.rate), "top-up");
   deck.finish_insertion(0.5 * pill_mass);
   deck.end_block("top_up.in", fmt::format("${{short}} > {}", 0.5 * pill_mass));
   deck.settle("fill: settling", p.settle_speed, p.settle_max);
@@ -328,3 +352,16 @@ RepeatResult liggghts_repeat(Ctx& c) {
 }
 
 }  // namespace clumpkit::rigs::detail
+
+namespace clumpkit::rigs {
+
+void check_engine(const std::string& engine, int ranks) {
+  if (engine != "clumpkit" && engine != "liggghts")
+    throw InputError("--engine", engine, "unknown engine (known: clumpkit, liggghts)");
+  if (ranks > 1 && engine != "liggghts")
+    throw InputError("--np", std::to_string(ranks),
+                     "MPI ranks are for --engine liggghts (clumpkit's runner uses --threads)");
+  if (engine == "liggghts") detail::require_liggghts(ranks);
+}
+
+}  // namespace clumpkit::rigs

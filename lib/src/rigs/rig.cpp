@@ -207,8 +207,7 @@ RigResult run_rig(const RigRequest& req) {
   res.params = rig_scale(req.rig, req.settings);
   if (req.adjust) req.adjust(res.params);
   res.scale = res.params.name;
-  if (req.engine != "clumpkit" && req.engine != "liggghts")
-    throw InputError("--engine", req.engine, "unknown engine (known: clumpkit, liggghts)");
+  check_engine(req.engine, req.liggghts_ranks);
   if (req.engine == "liggghts" && !req.bed_from.empty())
     throw InputError("--bed-from", req.bed_from.string(), "not with --engine liggghts");
   // A folder holds one engine's repeats: mixing them would average two codes.

@@ -80,6 +80,11 @@ class RigSimulator final : public Simulator {
     /// gain more from running side by side than from threads inside one run.
     int jobs = 1;
     long rays = 20000;
+    /// "clumpkit" (the bundled runner) or "liggghts" (each run a LIGGGHTS deck, rigs::RigRequest
+    /// ::engine, on `liggghts_ranks` MPI ranks). LIGGGHTS results are cached under their own keys
+    /// (engine and ranks: another decomposition is another trajectory).
+    std::string engine = "clumpkit";
+    int liggghts_ranks = 1;
     std::function<void(const std::string&)> progress;
   };
   explicit RigSimulator(Options options);

@@ -128,6 +128,11 @@ struct RigResult {
   nlohmann::json to_json() const;
 };
 
+/// Checks an engine choice before anything runs: InputError for an unknown engine, MPI ranks
+/// (`ranks` > 1) for the bundled runner, or a LIGGGHTS (or, for ranks > 1, an mpirun) that is not
+/// installed.
+void check_engine(const std::string& engine, int ranks);
+
 /// Runs all repeats. A repeat that blows up stops the run: the result then holds the finished
 /// repeats and `error`; the caller decides the exit status.
 RigResult run_rig(const RigRequest& request);
