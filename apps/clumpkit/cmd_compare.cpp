@@ -261,6 +261,7 @@ Command setup_diagnose(CLI::App& parent) {
         o.suggest = !a->no_suggest && a->suggest != "never";
         o.suggest_always = a->suggest == "always";
         o.pairs = !a->no_pairs;
+        o.engine = a->engine;
         std::string list = a->effects;
         for (size_t p; (p = list.find(',')) != std::string::npos; list.erase(0, p + 1))
           if (p > 0) o.effects.push_back(list.substr(0, p));

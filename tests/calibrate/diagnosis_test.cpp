@@ -510,6 +510,44 @@ TEST(Diagnosis, ADiscreteLevelIsChosenOnRunsWithEveryRepeat) {
   for (const auto& ob : top.comparison.observables) EXPECT_EQ(ob.simulated.n, 2);
 }
 
+// LIGGGHTS has no standard rolling model and runs it as CDT, so on LIGGGHTS a baseline with
+// one of the two is not screened against the other (the same physics there, run twice): only
+// EPSD is tried, and the skipped level is named with the reason. A hidden EPSD is still found.
+TEST(Diagnosis, OnLiggghtsTheRollingModelIsNotScreenedAgainstItsTwin) {
+  for (const auto base_law : {dem::RollingModel::kStandard, dem::RollingModel::kCdt}) {
+    fake::Adjusted sim;
+    std::set<int> simulated_laws;
+    sim.strip = [](ParticleModel& m) { m.effects.rolling_model.reset(); };
+    sim.adjust = [&](const ParticleModel& m, const SimRequest& r, int, SimValues& v) {
+      const auto law = m.effects.rolling_model.value_or(dem::RollingModel::kStandard);
+      simulated_laws.insert(static_cast<int>(law));
+      if (law == dem::RollingModel::kEpsd && r.rig == "angle_of_repose")
+        for (auto& [q, x] : v) x.mean -= 3.0;
+    };
+    ParticleModel base = base_model();
+    set_model_effect(base, "effects.rolling_model", dem::to_string(base_law), "test");
+    ParticleModel truth = base;
+    set_model_effect(truth, "effects.rolling_model", "epsd", "test");
+    const auto ms = synthesize(sim, truth, 0.02, 78);
+    simulated_laws.clear();
+    DiagnoseOptions o;
+    o.suggest = false;
+    o.effects = {"rolling_model"};
+    o.engine = "liggghts";
+    const Diagnosis d = diagnose(base, ms, sim, o);
+    const auto twin = base_law == dem::RollingModel::kStandard ? dem::RollingModel::kCdt
+                                                               : dem::RollingModel::kStandard;
+    EXPECT_EQ(simulated_laws.count(static_cast<int>(twin)), 0u) << d.summary();
+    EXPECT_TRUE(std::any_of(d.skipped.begin(), d.skipped.end(), [&](const std::string& s) {
+      return s.find(std::string("rolling_model=") + dem::to_string(twin)) == 0 &&
+             s.find("on LIGGGHTS") != std::string::npos;
+    })) << d.summary();
+    ASSERT_EQ(d.verdict, "rolling_model") << d.summary();
+    EXPECT_EQ(d.candidates.front().fitted,
+              static_cast<double>(static_cast<int>(dem::RollingModel::kEpsd)));
+  }
+}
+
 TEST(Diagnosis, ChiSquareSurvivalMatchesKnownValues) {
   EXPECT_NEAR(chi2_survival(3.841, 1), 0.05, 1e-4);
   EXPECT_NEAR(chi2_survival(18.307, 10), 0.05, 1e-4);

@@ -195,8 +195,33 @@ class Diagnoser {
   double rank();
 };
 
+// On LIGGGHTS the standard rolling model runs as CDT: of the two, the level the baseline does
+// not hold is the baseline's own physics there, and screening it would spend runs on a copy.
+void drop_liggghts_rolling_twins(std::vector<EffectCandidate>& cands, const ParticleModel& base,
+                                 std::vector<std::string>& skipped) {
+  const auto cur = base.effects.rolling_model.value_or(dem::RollingModel::kStandard);
+  if (cur == dem::RollingModel::kEpsd) return;
+  const auto twin =
+      cur == dem::RollingModel::kStandard ? dem::RollingModel::kCdt : dem::RollingModel::kStandard;
+  for (auto it = cands.begin(); it != cands.end(); ++it) {
+    if (it->effect != "rolling_model") continue;
+    for (size_t i = 0; i < it->levels.size(); ++i)
+      if (static_cast<int>(it->levels[i]) == static_cast<int>(twin)) {
+        skipped.push_back(fmt::format(
+            "{}: on LIGGGHTS the standard rolling model runs as CDT, the baseline's own law",
+            it->level_names[i]));
+        it->levels.erase(it->levels.begin() + static_cast<long>(i));
+        it->level_names.erase(it->level_names.begin() + static_cast<long>(i));
+        break;
+      }
+    if (it->levels.empty()) cands.erase(it);
+    return;
+  }
+}
+
 void Diagnoser::screen() {
-  const std::vector<EffectCandidate> cands = effect_candidates(base, o.effects, &d.skipped);
+  std::vector<EffectCandidate> cands = effect_candidates(base, o.effects, &d.skipped);
+  if (o.engine == "liggghts") drop_liggghts_rolling_twins(cands, base, d.skipped);
   {
     std::vector<ParticleModel> first;
     for (const auto& c : cands) {

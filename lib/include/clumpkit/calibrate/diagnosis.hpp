@@ -31,8 +31,12 @@ struct DiagnoseOptions {
   int screen_repeats = 1;
   std::uint64_t seed = 1;
   std::vector<std::string> effects;  ///< empty: the whole catalogue
-  int refinements = 2;               ///< real-run refinement steps for the leading candidates
-  int refine_top = 3;                ///< how many leading candidates are refined
+  /// The simulator's engine ("clumpkit" or "liggghts"). LIGGGHTS has no standard rolling model
+  /// and runs it as CDT, so there a baseline with the standard model is not screened against
+  /// CDT (the same physics), nor a CDT baseline against the standard model.
+  std::string engine = "clumpkit";
+  int refinements = 2;  ///< real-run refinement steps for the leading candidates
+  int refine_top = 3;   ///< how many leading candidates are refined
   /// Further steps for the candidate whose fit leads, while its fit still moves by more than a
   /// quarter of its uncertainty (a response far from a parabola converges in more steps); only
   /// where the baseline is inconsistent with the data (p < p_inconsistent).
