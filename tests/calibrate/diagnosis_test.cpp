@@ -1,7 +1,9 @@
 #include "clumpkit/calibrate/diagnosis.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -266,6 +268,57 @@ TEST(Diagnosis, AFailedRunNarrowsTheRangeInsteadOfDroppingTheCandidate) {
       << top.fitted << " +/- " << top.fitted_std;
   EXPECT_EQ(top.chi2_source, "run");
   for (const auto& s : d.skipped) EXPECT_EQ(s.find("cohesion"), std::string::npos) << s;
+}
+
+// A run that fails at the bound of a candidate's range (a tiny LIGGGHTS diagnosis, session 38:
+// pill-wall friction refined at 0, where the heap spread flat, "no cone to measure"). The range
+// must then end short of the bound as it does short of a failure inside it. Before, a failure at
+// the bound did not narrow the range (it was the range's own end), the fit went back to it and
+// the same failing run was made again. Here the data want no rolling friction at all and the
+// rigs cannot measure below mu_r = 0.01: no value may fail twice, and rolling friction stays a
+// candidate, fitted short of the failure.
+TEST(Diagnosis, AFailureAtTheRangesBoundIsNotRunAgain) {
+  struct Limited final : Simulator {
+    std::vector<double> failed;
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      const auto& rf = m.effects.rolling_friction;
+      const double mur = rf && rf->count("pill") ? rf->at("pill") : 0.0;
+      if (mur < 0.006) {
+        failed.push_back(mur);
+        throw NumericalError("heap angle: the heap is only 5 mm high: no cone to measure");
+      }
+      ++runs_;
+      return inner.simulate(m, r, repeats, seed);
+    }
+  } sim;
+  const ParticleModel base = base_model();  // Table 1: mu_r 0.05-0.12
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.rolling_friction", "0", "test");
+  fake::FakeSimulator lab;  // the truth itself is measured
+  const auto ms = synthesize(lab, truth, 0.02, 5);
+  DiagnoseOptions o;
+  o.suggest = false;
+  o.effects = {"rolling_friction", "particle_friction"};
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  EXPECT_GE(sim.failed.size(), 1u) << "a fit at the bound 0 should fail there";
+  std::vector<double> values = sim.failed;
+  std::sort(values.begin(), values.end());
+  EXPECT_TRUE(std::adjacent_find(values.begin(), values.end()) == values.end())
+      << "a failing value was run again; " << d.summary();
+  bool found = false;
+  for (const CandidateResult& r : d.candidates)
+    if (r.candidate.effect == "rolling_friction") {
+      found = true;
+      EXPECT_NE(r.limit.find("no cone"), std::string::npos) << r.limit;
+      EXPECT_GE(r.fitted, 0.006) << d.summary();
+      EXPECT_TRUE(r.at_limit) << d.summary();
+    }
+  std::string fails, skipped;
+  for (double v : sim.failed) fails += fmt::format(" {}", v);
+  for (const auto& k : d.skipped) skipped += "\n  " + k;
+  EXPECT_TRUE(found) << d.summary() << "failed at" << fails << "; skipped:" << skipped;
 }
 
 // Responses no parabola over the whole range follows: the packing may fall fast with the first

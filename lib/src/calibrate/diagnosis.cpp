@@ -37,6 +37,9 @@ struct Work {
   /// at a value where a run failed (`limit` says where and why); fits stay short of it
   /// (fit_range), by half the way from the nearest measured value.
   double lo_ok = 0.0, hi_ok = 0.0;
+  /// A run failed at lo_ok / hi_ok (which may be the range's own bound: a pill-wall friction of
+  /// 0 that lets the heap spread flat).
+  bool lo_failed = false, hi_failed = false;
   std::string limit;
   int failures = 0;
   int steps_left = 0;  ///< refinement steps still allowed
@@ -144,10 +147,13 @@ class Diagnoser {
     double nearest = w.c.baseline;
     for (const auto& p : w.s.points)
       if (std::abs(p.first - theta) < std::abs(nearest - theta)) nearest = p.first;
-    if (theta > nearest)
+    if (theta > nearest) {
       w.hi_ok = std::min(w.hi_ok, theta);
-    else
+      w.hi_failed = true;
+    } else {
       w.lo_ok = std::max(w.lo_ok, theta);
+      w.lo_failed = true;
+    }
     ++w.failures;
     w.limit = "the rigs could not measure at " + w.c.format(theta) + ": " + why;
     say(fmt::format("{}: {}; fitting short of it", w.c.effect, w.limit));
@@ -156,13 +162,13 @@ class Diagnoser {
   // from the nearest measured value (so refinements bisect toward a failure).
   static std::pair<double, double> fit_range(const Work& w) {
     double lo = w.lo_ok, hi = w.hi_ok;
-    if (w.hi_ok < w.c.hi) {
+    if (w.hi_failed) {
       double g = lo;
       for (const auto& p : w.s.points)
         if (p.first < w.hi_ok) g = std::max(g, p.first);
       hi = 0.5 * (g + w.hi_ok);
     }
-    if (w.lo_ok > w.c.lo) {
+    if (w.lo_failed) {
       double g = hi;
       for (const auto& p : w.s.points)
         if (p.first > w.lo_ok) g = std::min(g, p.first);
@@ -691,8 +697,8 @@ double Diagnoser::rank() {
     r.limit = w.limit;
     if (!w.c.discrete && !w.limit.empty()) {
       const auto [lo, hi] = fit_range(w);
-      r.at_limit = (w.hi_ok < w.c.hi && r.fitted >= hi - 0.01 * span) ||
-                   (w.lo_ok > w.c.lo && r.fitted <= lo + 0.01 * span);
+      r.at_limit = (w.hi_failed && r.fitted >= hi - 0.01 * span) ||
+                   (w.lo_failed && r.fitted <= lo + 0.01 * span);
     }
     r.plausible =
         w.c.discrete || (r.fitted >= w.c.lo && r.fitted <= w.c.hi && !r.at_bound && !r.at_limit);
