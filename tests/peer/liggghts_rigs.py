@@ -85,7 +85,9 @@ def liggghts_through_compare(a, rig, quantity, np, work):
     with open(lab, "w") as f:
         f.write("rig,sample,setting,quantity,value,std,n,unit\n")
         f.write({"bulk_density": "bulk_density,mix,,bulk_density,730,10,3,kg/m^3\n",
-                 "angle_of_repose": "angle_of_repose,mix,,angle,25,1,3,deg\n"}[rig])
+                 "angle_of_repose": "angle_of_repose,mix,,angle,25,1,3,deg\n",
+                 # the speed of EXTRA's --set rpm=30
+                 "discharge": "discharge,mix,rpm=30,pocket_mass,0.17,0.01,3,kg\n"}[rig])
     cmd = [a.clumpkit, "compare", "--model", model_file(work), "--measurements", lab,
            "--engine", "liggghts", "--np", str(np), "--scale", a.scale, "--repeats",
            str(a.repeats), "--seed", str(a.seed), "--cache", cache]
