@@ -116,17 +116,26 @@ RigSimulator::Entry RigSimulator::entry(const ParticleModel& model, const SimReq
 }
 
 namespace {
-// The cached values of an entry, if its file exists, is readable and holds this very key.
-std::optional<SimValues> read_cached(const fs::path& file, const std::string& key) {
+// A cached run: its values, or why the rigs could not measure (a blow-up, a heap too flat for a
+// cone: the same model, request and seeds fail the same way again, so a failure is kept too).
+struct Cached {
+  SimValues values;
+  std::string error;
+};
+
+// The cached run of an entry, if its file exists, is readable and holds this very key.
+std::optional<Cached> read_cached(const fs::path& file, const std::string& key) {
   std::error_code ec;
   if (!fs::exists(file, ec)) return std::nullopt;
   try {
     const json j = json::parse(read_file(file));
     if (j.value("key", "") != key) return std::nullopt;
-    SimValues v;
+    Cached c;
+    c.error = j.value("error", "");
+    if (!c.error.empty()) return c;
     for (const auto& [q, x] : j.at("values").items())
-      v[q] = {x.at("mean").get<double>(), x.at("std").get<double>(), x.at("n").get<int>()};
-    return v;
+      c.values[q] = {x.at("mean").get<double>(), x.at("std").get<double>(), x.at("n").get<int>()};
+    return c;
   } catch (const std::exception&) {
     return std::nullopt;  // a damaged cache entry is recomputed
   }
@@ -167,9 +176,18 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
                                                 std::max(1, opt_.liggghts_ranks))));
   }
   const rigs::RigResult r = rigs::run_rig(rr);
-  if (!r.error.empty())
-    throw NumericalError(
-        fmt::format("rig {} for model {} failed: {}", req.rig, e.model.name, r.error));
+  if (!r.error.empty()) {
+    const std::string why =
+        fmt::format("rig {} for model {} failed: {}", req.rig, e.model.name, r.error);
+    write_file_atomic(e.file,
+                      json{{"key", e.key}, {"error", why}, {"result", r.to_json()}}.dump(1));
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++runs_;
+      made_.insert(e.file);
+    }
+    throw NumericalError(why);
+  }
   std::map<std::string, double> mean, sd;
   int n = 0;
   for (const auto& [q, st] : r.stats) {
@@ -192,9 +210,10 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
                                  std::uint64_t seed) {
   const Entry e = entry(model, req, repeats, seed);
   folders_.push_back(e.run_dir);
-  if (auto v = read_cached(e.file, e.key)) {
+  if (auto c = read_cached(e.file, e.key)) {
     if (!made_.count(e.file)) ++hits_;
-    return *v;
+    if (!c->error.empty()) throw NumericalError(c->error + " (a cached failure)");
+    return c->values;
   }
   return run(e, req, repeats, seed, opt_.threads);
 }

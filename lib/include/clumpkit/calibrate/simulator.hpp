@@ -70,7 +70,9 @@ std::map<std::string, SimulatedValue> simulate_measurements(
     Simulator& sim, const ParticleModel& model, const std::vector<Measurement>& measurements,
     const std::string& scale, int repeats, std::uint64_t seed);
 
-/// The real rigs, with an on-disk cache (one JSON per run, written atomically).
+/// The real rigs, with an on-disk cache (one JSON per run, written atomically). A run that fails
+/// (NumericalError: a blow-up, a heap too flat to measure) is cached as a failure and thrown
+/// again, so a second diagnosis of the same data simulates nothing either.
 class RigSimulator final : public Simulator {
  public:
   struct Options {
