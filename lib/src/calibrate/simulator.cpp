@@ -211,8 +211,10 @@ SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& r
   const Entry e = entry(model, req, repeats, seed);
   folders_.push_back(e.run_dir);
   if (auto c = read_cached(e.file, e.key)) {
-    if (!made_.count(e.file)) ++hits_;
-    if (!c->error.empty()) throw NumericalError(c->error + " (a cached failure)");
+    const bool earlier = !made_.count(e.file);  // an earlier process's result, not our prefetch's
+    if (earlier) ++hits_;
+    if (!c->error.empty())
+      throw NumericalError(earlier ? c->error + " (a cached failure)" : c->error);
     return c->values;
   }
   return run(e, req, repeats, seed, opt_.threads);
