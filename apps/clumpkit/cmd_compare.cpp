@@ -65,6 +65,11 @@ void common_options(CLI::App* c, CalArgs& a) {
   c->add_flag("--quiet", a.quiet, "No progress lines");
 }
 
+// MPI ranks per rig run, as the JSON reports them (0: the bundled runner).
+int mpi_ranks(const CalArgs& a) {
+  return a.engine == "liggghts" ? a.np : 0;
+}
+
 RigSimulator make_sim(const CalArgs& a) {
   RigSimulator::Options o;
   o.cache_dir = a.cache;
@@ -188,7 +193,7 @@ Command setup_compare(CLI::App& parent) {
               out["scale"] = a->scale;
               out["repeats"] = a->repeats;
               out["engine"] = a->engine;
-              out["mpi_ranks"] = a->engine == "liggghts" ? a->np : 0;
+              out["mpi_ranks"] = mpi_ranks(*a);
               if (chain.size() > 1) out["chain"] = chain;
               write_json(out, a->json);
             }
@@ -347,7 +352,7 @@ Command setup_diagnose(CLI::App& parent) {
                     {"skipped", d.skipped},
                     {"simulations", d.simulations},
                     {"engine", a->engine},
-                    {"mpi_ranks", a->engine == "liggghts" ? a->np : 0},
+                    {"mpi_ranks", mpi_ranks(*a)},
                     {"summary", d.summary()}};
         ReportInput rep;
         rep.chain.emplace_back(base.name, d.baseline);

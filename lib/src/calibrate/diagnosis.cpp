@@ -207,22 +207,21 @@ void drop_liggghts_rolling_twins(std::vector<EffectCandidate>& cands, const Part
                                  std::vector<std::string>& skipped) {
   const auto cur = base.effects.rolling_model.value_or(dem::RollingModel::kStandard);
   if (cur == dem::RollingModel::kEpsd) return;
-  const auto twin =
-      cur == dem::RollingModel::kStandard ? dem::RollingModel::kCdt : dem::RollingModel::kStandard;
-  for (auto it = cands.begin(); it != cands.end(); ++it) {
-    if (it->effect != "rolling_model") continue;
-    for (size_t i = 0; i < it->levels.size(); ++i)
-      if (static_cast<int>(it->levels[i]) == static_cast<int>(twin)) {
-        skipped.push_back(fmt::format(
-            "{}: on LIGGGHTS the standard rolling model runs as CDT, the baseline's own law",
-            it->level_names[i]));
-        it->levels.erase(it->levels.begin() + static_cast<long>(i));
-        it->level_names.erase(it->level_names.begin() + static_cast<long>(i));
-        break;
-      }
-    if (it->levels.empty()) cands.erase(it);
-    return;
-  }
+  const int twin = static_cast<int>(
+      cur == dem::RollingModel::kStandard ? dem::RollingModel::kCdt : dem::RollingModel::kStandard);
+  const auto c = std::find_if(cands.begin(), cands.end(),
+                              [](const EffectCandidate& e) { return e.effect == "rolling_model"; });
+  if (c == cands.end()) return;
+  for (size_t i = 0; i < c->levels.size(); ++i)
+    if (static_cast<int>(c->levels[i]) == twin) {
+      skipped.push_back(c->level_names[i] +
+                        ": on LIGGGHTS the standard rolling model runs as CDT, the baseline's "
+                        "own law");
+      c->levels.erase(c->levels.begin() + static_cast<long>(i));
+      c->level_names.erase(c->level_names.begin() + static_cast<long>(i));
+      break;
+    }
+  if (c->levels.empty()) cands.erase(c);
 }
 
 void Diagnoser::screen() {

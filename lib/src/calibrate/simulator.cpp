@@ -176,33 +176,34 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
                                                 std::max(1, opt_.liggghts_ranks))));
   }
   const rigs::RigResult r = rigs::run_rig(rr);
-  if (!r.error.empty()) {
-    const std::string why =
-        fmt::format("rig {} for model {} failed: {}", req.rig, e.model.name, r.error);
-    write_file_atomic(e.file,
-                      json{{"key", e.key}, {"error", why}, {"result", r.to_json()}}.dump(1));
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++runs_;
-      made_.insert(e.file);
+  // The entry keeps the run's values, or why the rigs could not measure (thrown again when asked).
+  json entry = {{"key", e.key}, {"result", r.to_json()}};
+  SimValues v;
+  const std::string why = r.error.empty() ? ""
+                                          : fmt::format("rig {} for model {} failed: {}", req.rig,
+                                                        e.model.name, r.error);
+  if (why.empty()) {
+    std::map<std::string, double> mean, sd;
+    int n = 0;
+    for (const auto& [q, st] : r.stats) {
+      mean[q] = st.mean;
+      sd[q] = st.std;
+      n = st.n;
     }
-    throw NumericalError(why);
+    v = to_canonical(req.rig, mean, sd, n);
+    json values = json::object();
+    for (const auto& [q, x] : v) values[q] = {{"mean", x.mean}, {"std", x.std}, {"n", x.n}};
+    entry["values"] = values;
+  } else {
+    entry["error"] = why;
   }
-  std::map<std::string, double> mean, sd;
-  int n = 0;
-  for (const auto& [q, st] : r.stats) {
-    mean[q] = st.mean;
-    sd[q] = st.std;
-    n = st.n;
+  write_file_atomic(e.file, entry.dump(1));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++runs_;
+    made_.insert(e.file);
   }
-  SimValues v = to_canonical(req.rig, mean, sd, n);
-  json values = json::object();
-  for (const auto& [q, x] : v) values[q] = {{"mean", x.mean}, {"std", x.std}, {"n", x.n}};
-  write_file_atomic(e.file,
-                    json{{"key", e.key}, {"values", values}, {"result", r.to_json()}}.dump(1));
-  std::lock_guard<std::mutex> lock(mutex_);
-  ++runs_;
-  made_.insert(e.file);
+  if (!why.empty()) throw NumericalError(why);
   return v;
 }
 

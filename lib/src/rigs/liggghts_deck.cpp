@@ -483,25 +483,25 @@ std::vector<std::vector<double>> read_dump_rows(const std::string& path, int col
   return rows;
 }
 
-void require_liggghts(int np) {
-  if (which("liggghts").empty())
+LiggghtsPrograms require_liggghts(int np) {
+  LiggghtsPrograms p{which("liggghts"), np > 1 ? which("mpirun") : ""};
+  if (p.liggghts.empty())
     throw InputError("--engine", "liggghts",
                      "LIGGGHTS is not installed (Debian: apt-get install liggghts)");
-  if (np > 1 && which("mpirun").empty())
+  if (np > 1 && p.mpirun.empty())
     throw InputError("--np", std::to_string(np),
                      "mpirun is not installed (Debian: apt-get install openmpi-bin)");
+  return p;
 }
 
 void run_liggghts(const std::string& dir, int np,
                   const std::function<void(const std::string&)>& say) {
-  require_liggghts(np);
-  const std::string liggghts = which("liggghts");
+  const auto [liggghts, mpirun] = require_liggghts(np);
   // Line-buffered, so progress arrives as it happens and an MPI abort loses no ERROR line.
   const std::string stdbuf = which("stdbuf");
   std::string cmd = (stdbuf.empty() ? "" : shell_quote(stdbuf) + " -oL -eL ") +
                     shell_quote(liggghts) + " -in in.rig -log liggghts.log";
   if (np > 1) {
-    const std::string mpirun = which("mpirun");
     // OpenMPI refuses root without the flag; containers often forbid its shared-memory single
     // copy (ptrace), which it then reports as an error in every exchange.
     cmd = fmt::format(

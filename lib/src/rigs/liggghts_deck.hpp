@@ -101,8 +101,12 @@ std::vector<std::vector<double>> read_dump_rows(const std::string& path, int col
 std::vector<std::vector<double>> read_dump_rows(const std::string& path, int columns,
                                                 long* timestep);
 
-/// Throws InputError when liggghts (or, for np > 1, mpirun) is not on the PATH.
-void require_liggghts(int np);
+/// The programs a LIGGGHTS run on np ranks needs, found on the PATH (mpirun only for np > 1).
+struct LiggghtsPrograms {
+  std::string liggghts, mpirun;
+};
+/// Finds them; InputError when liggghts (or, for np > 1, mpirun) is not installed.
+LiggghtsPrograms require_liggghts(int np);
 
 /// Runs `liggghts -in in.rig` in `dir` (under `mpirun -np np` for np > 1), passing every line
 /// the deck prints as "clumpkit: ..." to `say`; the whole screen output goes to dir/screen.txt.

@@ -204,22 +204,19 @@ RepeatResult liggghts_angle_of_repose(Ctx& c) {
   // bundled runner does; the heap settles once, after it.
   deck.line(fmt::format("variable short equal {}-${{{}}}", p.heap_mass, in_column));
   const dem::FactorySettings top = a.top_up(0.0, p.heap_mass);
+  const double m_pill = expected_pill_mass(a.ws, top);
   deck.begin_block();
   deck.line("print \"clumpkit: the tube holds less than asked: pouring ${short} kg from above\"");
   // LIGGGHTS places floor(mass / mean pill mass) pills, and an insertion of none stops the next
-  // run ("'start' step can not be before current step"; found with a 0.57-pill shortfall). Half
-  // a pill more places the nearest whole number of pills, and at least one.
-  const double m_pill = expected_pill_mass(a.ws, top);
-  // max(a, b) as (a + b + |a - b|) / 2: an equal-style max() is LIGGGHTS's reduction of a
-  // compute.
-  deck.line(
-      fmt::format("variable top_kg equal 0.5*((${{short}}+{0:.12g})+{1:.12g}+abs((${{short}}+"
-                  "{0:.12g})-{1:.12g}))",
-                  0.5 * m_pill, m_pill * (1 + 1e-6)));
+  // run ("'start' step can not be before current step"; found with a 0.57-pill shortfall). The
+  // block runs for a shortfall above half a mean pill, as the bundled runner's top-up does, so
+  // the shortfall plus half a pill (a hair more, for LIGGGHTS's rounding of the templates'
+  // masses) is the nearest whole number of pills and at least one.
+  deck.line(fmt::format("variable top_kg equal ${{short}}+{:.12g}", (0.5 + 1e-6) * m_pill));
   const double interval = deck.insert(top, "top_kg") - *top.mass / top.rate;
   deck.run(fmt::format("{:.10g}+${{top_kg}}/{:.10g}", interval, top.rate), "top-up");
   deck.finish_insertion(0.5 * pill_mass);
-  deck.end_block("top_up.in", fmt::format("${{short}} > {}", 0.5 * pill_mass));
+  deck.end_block("top_up.in", fmt::format("${{short}} > {:.12g}", 0.5 * m_pill));
   deck.settle("fill: settling", p.settle_speed, p.settle_max);
   deck.line("variable top equal bound(all,zmax)");
   deck.line(fmt::format("variable lift equal ${{top}}+{}", a.br + 0.01));
@@ -352,16 +349,3 @@ RepeatResult liggghts_repeat(Ctx& c) {
 }
 
 }  // namespace clumpkit::rigs::detail
-
-namespace clumpkit::rigs {
-
-void check_engine(const std::string& engine, int ranks) {
-  if (engine != "clumpkit" && engine != "liggghts")
-    throw InputError("--engine", engine, "unknown engine (known: clumpkit, liggghts)");
-  if (ranks > 1 && engine != "liggghts")
-    throw InputError("--np", std::to_string(ranks),
-                     "MPI ranks are for --engine liggghts (clumpkit's runner uses --threads)");
-  if (engine == "liggghts") detail::require_liggghts(ranks);
-}
-
-}  // namespace clumpkit::rigs

@@ -8,6 +8,7 @@
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
+#include "liggghts_deck.hpp"
 #include "procedure.hpp"
 
 namespace clumpkit::rigs {
@@ -196,6 +197,15 @@ nlohmann::json RigResult::to_json() const {
                       {"repeats", reps}};
   if (!error.empty()) j["error"] = error;
   return j;
+}
+
+void check_engine(const std::string& engine, int ranks) {
+  if (engine != "clumpkit" && engine != "liggghts")
+    throw InputError("--engine", engine, "unknown engine (known: clumpkit, liggghts)");
+  if (ranks > 1 && engine != "liggghts")
+    throw InputError("--np", std::to_string(ranks),
+                     "MPI ranks are for --engine liggghts (clumpkit's runner uses --threads)");
+  if (engine == "liggghts") detail::require_liggghts(ranks);
 }
 
 RigResult run_rig(const RigRequest& req) {
