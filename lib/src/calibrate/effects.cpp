@@ -49,6 +49,21 @@ double first_value(const std::optional<std::map<std::string, double>>& v, const 
   return it != v->end() ? it->second : (v->empty() ? fallback : v->begin()->second);
 }
 
+// A partner material's value when the reference partner's is x, for an effect the baseline holds
+// per partner (Table 1's pill-wall values differ by wall): the piecewise-linear map through
+// (lo, lo), (x0, b) and (hi, hi), x0 being the reference's baseline value and b the partner's.
+// So the candidate at x0 is the baseline model itself (its run is the candidate's point there),
+// the baseline's contrasts between materials are kept near it and fade towards the range's ends,
+// and every partner's value rises with x. A partner the baseline holds at the reference's value
+// gets x itself (bit for bit: a uniform baseline gives uniform variants), and one held outside
+// [lo, hi] keeps its value.
+double partner_value(double b, double x0, double lo, double hi, double x) {
+  if (b == x0) return x;
+  if (x == x0 || b < lo || b > hi) return b;
+  if (x < x0) return lo + (x - lo) * ((b - lo) / (x0 - lo));
+  return b + (x - x0) * ((hi - b) / (hi - x0));
+}
+
 // A probe inside the range, a fixed step from the baseline, towards the range's middle.
 double probe_from(double base, double step, double lo, double hi) {
   const double up = base + step, down = base - step;
@@ -73,9 +88,12 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
   std::vector<EffectCandidate> out;
 
   // A continuous effect: one parameter set through a model-file key (`unit` appended to values).
+  // `partners`: an effect held per partner material; the parameter is the value of partner `ref`
+  // and the others move with it (partner_value) where the baseline holds them apart.
   auto continuous = [&](const std::string& effect, const std::string& parameter,
-                        const std::string& unit, double lo, double hi, double baseline,
-                        double step) {
+                        const std::string& unit, double lo, double hi, double baseline, double step,
+                        const std::optional<std::map<std::string, double>>* partners = nullptr,
+                        const std::string& ref = "", const std::string& moved = "") {
     if (!wanted(effect)) return;
     EffectCandidate c;
     c.effect = effect;
@@ -87,19 +105,39 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
     c.probe = probe_from(baseline, step, lo, hi);
     const std::string key = "effects." + effect;
     const std::string suffix = unit == "1" ? "" : " " + unit;
-    c.apply = [key, suffix](const ParticleModel& m, double v) {
-      return with(m, key, fmt::format("{:.17g}{}", v, suffix));
-    };
+    const bool apart = partners && *partners && (*partners)->count(ref) &&
+                       std::any_of((*partners)->begin(), (*partners)->end(),
+                                   [&](const auto& kv) { return kv.second != baseline; });
+    if (!apart) {
+      c.apply = [key, suffix](const ParticleModel& m, double v) {
+        return with(m, key, fmt::format("{:.17g}{}", v, suffix));
+      };
+    } else {
+      c.parameter = moved;
+      c.apply = [key, values = **partners, baseline, lo, hi](const ParticleModel& m, double v) {
+        ParticleModel variant = m;
+        for (const auto& [partner, b] : values)
+          set_model_effect(variant, key + "." + partner,
+                           fmt::format("{:.17g}", partner_value(b, baseline, lo, hi, v)),
+                           "diagnosis");
+        variant.name = m.name + " [" + variant_label(key, fmt::format("{:.17g}", v)) + "]";
+        return variant;
+      };
+    }
     out.push_back(c);
   };
   continuous("rolling_friction", "mu_r, pill-pill and pill-wall", "1", 0.0, 0.5,
-             first_value(fx.rolling_friction, "pill", 0.0), 0.08);
+             first_value(fx.rolling_friction, "pill", 0.0), 0.08, &fx.rolling_friction, "pill",
+             "mu_r, pill-pill (the pill-wall values move with it from the baseline's)");
   continuous("particle_friction", "mu_s, pill-pill", "1", 0.0, 1.2,
              fx.particle_friction.value_or(0.0), 0.25);
   continuous("wall_friction", "mu_s, pill-wall (all wall materials)", "1", 0.0, 1.2,
-             first_value(fx.wall_friction, "galvanized_steel", 0.0), 0.25);
+             first_value(fx.wall_friction, "galvanized_steel", 0.0), 0.25, &fx.wall_friction,
+             "galvanized_steel",
+             "mu_s, pill-galvanized_steel (the other walls move with it from the baseline's)");
   continuous("restitution", "e, all pairs", "1", 0.05, 1.0,
-             first_value(fx.restitution, "pill", 1.0), 0.3);
+             first_value(fx.restitution, "pill", 1.0), 0.3, &fx.restitution, "pill",
+             "e, pill-pill (the pill-wall values move with it from the baseline's)");
   continuous("cohesion", "SJKR energy density, pill-pill", "J/m^3", 0.0, 5e4,
              fx.cohesion.value_or(0.0), 8e3);
   if (wanted("shape_resolution")) {

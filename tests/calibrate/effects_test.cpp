@@ -1,0 +1,110 @@
+// The diagnosis's candidate effects on real model files: a candidate at its baseline value is the
+// baseline model itself (the diagnosis uses the baseline's run as the candidate's point there),
+// per-material values move together with the fitted one, and uniform baselines stay uniform.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <random>
+
+#include "clumpkit/calibrate/effects.hpp"
+#include "clumpkit/rigs/model.hpp"
+
+namespace clumpkit::calibrate {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kModels = fs::path(CLUMPKIT_SOURCE_DIR) / "shapes" / "models";
+
+EffectCandidate find(const std::vector<EffectCandidate>& cs, const std::string& effect) {
+  for (const auto& c : cs)
+    if (c.effect == effect) return c;
+  throw std::runtime_error("no candidate " + effect);
+}
+
+// The per-partner values an effect holds in a model.
+std::map<std::string, double> partners(const ParticleModel& m, const std::string& effect) {
+  const auto& fx = m.effects;
+  const auto& slot = effect == "rolling_friction" ? fx.rolling_friction
+                     : effect == "wall_friction"  ? fx.wall_friction
+                                                  : fx.restitution;
+  if (!slot) throw std::runtime_error(effect + " is absent");
+  return *slot;
+}
+
+const char* const kPerPartner[] = {"rolling_friction", "wall_friction", "restitution"};
+
+TEST(EffectCandidates, AtItsBaselineValueEveryCandidateIsTheBaselineModel) {
+  // The production model holds Table 1's values: pill-wall rolling friction, friction and
+  // restitution differ by wall material. Before session 39 a candidate set every partner to the
+  // one fitted value, so at the baseline value it was another model (ABS's rolling friction 0.08
+  // instead of 0.12) and the diagnosis's line through the baseline's run was off.
+  const ParticleModel base = load_model(kModels / "production.toml");
+  const std::string want = model_fingerprint(base);
+  const auto cs = effect_candidates(base, {}, nullptr);
+  int continuous = 0;
+  for (const auto& c : cs) {
+    if (c.discrete || !base.effects.on(c.effect)) continue;  // cohesion: absent, not held at 0
+    ++continuous;
+    EXPECT_EQ(model_fingerprint(c.apply(base, c.baseline)), want) << c.effect;
+  }
+  EXPECT_GE(continuous, 5);  // rolling, particle and wall friction, restitution, size distribution
+  for (const char* e : kPerPartner)
+    EXPECT_NE(find(cs, e).parameter.find("move with it"), std::string::npos) << e;
+}
+
+TEST(EffectCandidates, PartnerValuesMoveWithTheFittedOneInsideTheRange) {
+  const ParticleModel base = load_model(kModels / "production.toml");
+  const auto cs = effect_candidates(base, {}, nullptr);
+  std::mt19937_64 rng(39);
+  for (const char* e : kPerPartner) {
+    const EffectCandidate c = find(cs, e);
+    const std::string ref = std::string(e) == "wall_friction" ? "galvanized_steel" : "pill";
+    const auto held = partners(base, e);
+    std::uniform_real_distribution<double> u(c.lo, c.hi);
+    for (int i = 0; i < 50; ++i) {
+      double x = u(rng), y = u(rng);
+      if (x > y) std::swap(x, y);
+      const auto px = partners(c.apply(base, x), e);
+      const auto py = partners(c.apply(base, y), e);
+      ASSERT_EQ(px.size(), held.size()) << e;
+      EXPECT_EQ(px.at(ref), x) << e;  // the parameter is the reference partner's value
+      for (const auto& [p, v] : px) {
+        EXPECT_GE(v, c.lo) << e << " " << p;
+        EXPECT_LE(v, c.hi) << e << " " << p;
+        EXPECT_LE(v, py.at(p)) << e << " " << p << ": " << x << " -> " << y;
+        // Above the baseline a partner held higher stays higher (and lower, lower).
+        if (x > c.baseline && p != ref) {
+          EXPECT_EQ(v > x, held.at(p) > c.baseline) << e << " " << p << " at " << x;
+        }
+      }
+    }
+    // The range's ends are the same for every partner.
+    for (const auto& [p, v] : partners(c.apply(base, c.hi), e)) EXPECT_DOUBLE_EQ(v, c.hi) << p;
+    for (const auto& [p, v] : partners(c.apply(base, c.lo), e)) EXPECT_DOUBLE_EQ(v, c.lo) << p;
+  }
+}
+
+TEST(EffectCandidates, AUniformOrAbsentBaselineGivesUniformVariants) {
+  // Every partner at the same value (the calibration loops' models): each variant sets every
+  // partner to the fitted value exactly, as before per-partner values moved (so their cached runs
+  // keep their keys). An absent effect is switched on at one value for every partner.
+  const ParticleModel table1 = load_model(kModels / "production.toml");
+  ParticleModel uniform = table1;
+  set_model_effect(uniform, "effects.rolling_friction", "0.05", "test");
+  ParticleModel absent = table1;
+  set_model_effect(absent, "effects.restitution", "off", "test");
+  for (const auto& [m, e] : {std::pair{uniform, "rolling_friction"}, {absent, "restitution"}}) {
+    const EffectCandidate c = find(effect_candidates(m, {e}, nullptr), e);
+    EXPECT_EQ(c.parameter.find("move with it"), std::string::npos) << e;
+    for (double x : {c.lo, 0.1234567890123, c.probe, c.hi}) {
+      ParticleModel set = m;
+      set_model_effect(set, std::string("effects.") + e, fmt::format("{:.17g}", x), "test");
+      EXPECT_EQ(model_fingerprint(c.apply(m, x)), model_fingerprint(set)) << e << " " << x;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace clumpkit::calibrate
