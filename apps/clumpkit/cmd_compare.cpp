@@ -307,7 +307,11 @@ Command setup_diagnose(CLI::App& parent) {
           return json{{"effect", e.effect},
                       {"parameter", e.parameter},
                       {"unit", e.unit},
-                      {"fitted", {{"value", value}, {"std", sd}, {"interval_95", {lo, hi}}}},
+                      {"fitted",
+                       {{"value", value},
+                        {"std", sd},
+                        {"interval_95", {lo, hi}},
+                        {"partners", e.partners ? json(e.partners(value)) : json(nullptr)}}},
                       {"range", {e.lo, e.hi}}};
         };
         for (const auto& r : d.candidates) {

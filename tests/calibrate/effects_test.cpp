@@ -70,6 +70,8 @@ TEST(EffectCandidates, PartnerValuesMoveWithTheFittedOneInsideTheRange) {
       const auto py = partners(c.apply(base, y), e);
       ASSERT_EQ(px.size(), held.size()) << e;
       EXPECT_EQ(px.at(ref), x) << e;  // the parameter is the reference partner's value
+      ASSERT_TRUE(c.partners) << e;
+      EXPECT_EQ(c.partners(x), px) << e;  // what the JSON reports is what the model gets
       for (const auto& [p, v] : px) {
         EXPECT_GE(v, c.lo) << e << " " << p;
         EXPECT_LE(v, c.hi) << e << " " << p;
@@ -98,6 +100,7 @@ TEST(EffectCandidates, AUniformOrAbsentBaselineGivesUniformVariants) {
   for (const auto& [m, e] : {std::pair{uniform, "rolling_friction"}, {absent, "restitution"}}) {
     const EffectCandidate c = find(effect_candidates(m, {e}, nullptr), e);
     EXPECT_EQ(c.parameter.find("move with it"), std::string::npos) << e;
+    EXPECT_FALSE(c.partners) << e;
     for (double x : {c.lo, 0.1234567890123, c.probe, c.hi}) {
       ParticleModel set = m;
       set_model_effect(set, std::string("effects.") + e, fmt::format("{:.17g}", x), "test");

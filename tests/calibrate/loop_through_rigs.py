@@ -192,6 +192,17 @@ def main():
               f"no false verdict (verdict: {d['verdict']})")
         check(not os.path.exists(w("v2.toml")), "--apply writes no model when nothing is missing")
         check(before <= 2.0, f"the baseline's chi2/dof {before:.2f} <= 2 (within noise)")
+    # The baseline holds Table 1's pill-wall friction per wall: a wall-friction candidate reports
+    # the value every wall gets at its fit (galvanized steel's is the parameter); a uniform
+    # baseline's candidates (rolling friction here) report none.
+    for cand in d["candidates"]:
+        partners = cand["fitted"]["partners"]
+        if cand["effect"] == "wall_friction":
+            check(partners is not None and sorted(partners) == sorted(PLATES)
+                  and partners["galvanized_steel"] == cand["fitted"]["value"],
+                  f"wall friction reports every wall's value at its fit ({partners})")
+        elif cand["effect"] in ("rolling_friction", "cohesion"):
+            check(partners is None, f"{cand['effect']} has one value for every partner")
     check(d2["simulations"] == 0 and "0 rig runs simulated" in again,
           f"a second diagnose is served from the cache ({d2['simulations']} runs)")
     if failures:

@@ -114,12 +114,15 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       };
     } else {
       c.parameter = moved;
-      c.apply = [key, values = **partners, baseline, lo, hi](const ParticleModel& m, double v) {
+      c.partners = [values = **partners, baseline, lo, hi](double v) {
+        std::map<std::string, double> at;
+        for (const auto& [partner, b] : values) at[partner] = partner_value(b, baseline, lo, hi, v);
+        return at;
+      };
+      c.apply = [key, at = c.partners](const ParticleModel& m, double v) {
         ParticleModel variant = m;
-        for (const auto& [partner, b] : values)
-          set_model_effect(variant, key + "." + partner,
-                           fmt::format("{:.17g}", partner_value(b, baseline, lo, hi, v)),
-                           "diagnosis");
+        for (const auto& [partner, x] : at(v))
+          set_model_effect(variant, key + "." + partner, fmt::format("{:.17g}", x), "diagnosis");
         variant.name = m.name + " [" + variant_label(key, fmt::format("{:.17g}", v)) + "]";
         return variant;
       };

@@ -3,6 +3,7 @@
 /// physical range and how to switch it on in a model. An effect already on is tried at a changed
 /// strength ("held at a baseline"); an absent one is switched on.
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@ struct EffectCandidate {
   std::vector<std::string> level_names;
   /// The baseline model with this effect set to `value`.
   std::function<ParticleModel(const ParticleModel&, double)> apply;
+  /// An effect the baseline holds at different values per partner material: every partner's
+  /// value when the parameter is `value` (the other partners move with it; docs/calibrate.md).
+  /// Empty: one value for every partner.
+  std::function<std::map<std::string, double>(double)> partners;
   std::string format(double value) const;  ///< "0.083" / "rolling_model=cdt" / "12 spheres"
 };
 
