@@ -54,6 +54,18 @@ TEST(EffectCandidates, AtItsBaselineValueEveryCandidateIsTheBaselineModel) {
     EXPECT_NE(find(cs, e).parameter.find("move with it"), std::string::npos) << e;
 }
 
+TEST(EffectCandidates, WithoutGalvanizedSteelWallFrictionIsTheFirstWallsValue) {
+  ParticleModel base = load_model(kModels / "production.toml");
+  base.effects.wall_friction =
+      std::map<std::string, double>{{"abs_plastic", 0.6}, {"organic_glass", 0.4}};
+  const EffectCandidate c =
+      find(effect_candidates(base, {"wall_friction"}, nullptr), "wall_friction");
+  EXPECT_EQ(c.baseline, 0.6);
+  EXPECT_NE(c.parameter.find("pill-abs_plastic"), std::string::npos) << c.parameter;
+  EXPECT_EQ(model_fingerprint(c.apply(base, c.baseline)), model_fingerprint(base));
+  EXPECT_EQ(partners(c.apply(base, 0.9), "wall_friction").at("abs_plastic"), 0.9);
+}
+
 TEST(EffectCandidates, PartnerValuesMoveWithTheFittedOneInsideTheRange) {
   const ParticleModel base = load_model(kModels / "production.toml");
   const auto cs = effect_candidates(base, {}, nullptr);

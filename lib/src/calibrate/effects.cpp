@@ -105,15 +105,17 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
     c.probe = probe_from(baseline, step, lo, hi);
     const std::string key = "effects." + effect;
     const std::string suffix = unit == "1" ? "" : " " + unit;
-    const bool apart = partners && *partners && (*partners)->count(ref) &&
-                       std::any_of((*partners)->begin(), (*partners)->end(),
-                                   [&](const auto& kv) { return kv.second != baseline; });
+    // The reference partner: `ref`, else the first the baseline holds (as first_value takes it).
+    const bool held = partners && *partners && !(*partners)->empty();
+    const std::string r = held && !(*partners)->count(ref) ? (*partners)->begin()->first : ref;
+    const bool apart = held && std::any_of((*partners)->begin(), (*partners)->end(),
+                                           [&](const auto& kv) { return kv.second != baseline; });
     if (!apart) {
       c.apply = [key, suffix](const ParticleModel& m, double v) {
         return with(m, key, fmt::format("{:.17g}{}", v, suffix));
       };
     } else {
-      c.parameter = moved;
+      c.parameter = fmt::format(fmt::runtime(moved), r);
       c.partners = [values = **partners, baseline, lo, hi](double v) {
         std::map<std::string, double> at;
         for (const auto& [partner, b] : values) at[partner] = partner_value(b, baseline, lo, hi, v);
@@ -137,7 +139,7 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
   continuous("wall_friction", "mu_s, pill-wall (all wall materials)", "1", 0.0, 1.2,
              first_value(fx.wall_friction, "galvanized_steel", 0.0), 0.25, &fx.wall_friction,
              "galvanized_steel",
-             "mu_s, pill-galvanized_steel (the other walls move with it from the baseline's)");
+             "mu_s, pill-{} (the other walls move with it from the baseline's)");
   continuous("restitution", "e, all pairs", "1", 0.05, 1.0,
              first_value(fx.restitution, "pill", 1.0), 0.3, &fx.restitution, "pill",
              "e, pill-pill (the pill-wall values move with it from the baseline's)");
