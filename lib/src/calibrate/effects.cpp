@@ -60,8 +60,8 @@ double first_value(const std::optional<std::map<std::string, double>>& v, const 
 double partner_value(double b, double x0, double lo, double hi, double x) {
   if (b == x0) return x;
   if (x == x0 || b < lo || b > hi) return b;
-  if (x < x0) return lo + (x - lo) * ((b - lo) / (x0 - lo));
-  return b + (x - x0) * ((hi - b) / (hi - x0));
+  if (x < x0) return x0 > lo ? lo + (x - lo) * ((b - lo) / (x0 - lo)) : b;
+  return hi > x0 ? b + (x - x0) * ((hi - b) / (hi - x0)) : b;
 }
 
 // A probe inside the range, a fixed step from the baseline, towards the range's middle.
