@@ -55,10 +55,11 @@ double first_value(const std::optional<std::map<std::string, double>>& v, const 
 // So the candidate at x0 is the baseline model itself (its run is the candidate's point there),
 // the baseline's contrasts between materials are kept near it and fade towards the range's ends,
 // and every partner's value rises with x. A partner the baseline holds at the reference's value
-// gets x itself (bit for bit: a uniform baseline gives uniform variants), and one held outside
-// [lo, hi] keeps its value.
+// gets x itself (bit for bit: a uniform baseline gives uniform variants), as every partner does
+// at the range's ends (a fit pinned at a bound runs the same model as a uniform baseline's), and
+// one held outside [lo, hi] keeps its value.
 double partner_value(double b, double x0, double lo, double hi, double x) {
-  if (b == x0) return x;
+  if (b == x0 || ((x == lo || x == hi) && b >= lo && b <= hi)) return x;  // the ends: exact
   if (x == x0 || b < lo || b > hi) return b;
   if (x < x0) return x0 > lo ? lo + (x - lo) * ((b - lo) / (x0 - lo)) : b;
   return hi > x0 ? b + (x - x0) * ((hi - b) / (hi - x0)) : b;
