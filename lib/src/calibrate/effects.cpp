@@ -42,11 +42,14 @@ ParticleModel with(const ParticleModel& base, const std::string& key, const std:
   return m;
 }
 
+// The partner a per-partner effect's one parameter stands for: `ref`, else the first one held.
+std::string reference_partner(const std::map<std::string, double>& v, const std::string& ref) {
+  return v.count(ref) || v.empty() ? ref : v.begin()->first;
+}
+
 double first_value(const std::optional<std::map<std::string, double>>& v, const std::string& k,
                    double fallback) {
-  if (!v) return fallback;
-  auto it = v->find(k);
-  return it != v->end() ? it->second : (v->empty() ? fallback : v->begin()->second);
+  return v && !v->empty() ? v->at(reference_partner(*v, k)) : fallback;
 }
 
 // A partner material's value when the reference partner's is x, for an effect the baseline holds
@@ -106,9 +109,7 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
     c.probe = probe_from(baseline, step, lo, hi);
     const std::string key = "effects." + effect;
     const std::string suffix = unit == "1" ? "" : " " + unit;
-    // The reference partner: `ref`, else the first the baseline holds (as first_value takes it).
     const bool held = partners && *partners && !(*partners)->empty();
-    const std::string r = held && !(*partners)->count(ref) ? (*partners)->begin()->first : ref;
     const bool apart = held && std::any_of((*partners)->begin(), (*partners)->end(),
                                            [&](const auto& kv) { return kv.second != baseline; });
     if (!apart) {
@@ -116,7 +117,7 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
         return with(m, key, fmt::format("{:.17g}{}", v, suffix));
       };
     } else {
-      c.parameter = fmt::format(fmt::runtime(moved), r);
+      c.parameter = fmt::format(fmt::runtime(moved), reference_partner(**partners, ref));
       c.partners = [values = **partners, baseline, lo, hi](double v) {
         std::map<std::string, double> at;
         for (const auto& [partner, b] : values) at[partner] = partner_value(b, baseline, lo, hi, v);
