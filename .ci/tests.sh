@@ -13,6 +13,13 @@ set -euo pipefail
 build="$1"
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export OMP_NUM_THREADS="${OMP_NUM_THREADS:-2}"
+# CTest runs two tests at once on the 2 cores, and a test whose OpenMP loops use both cores
+# then shares them with the other test. OpenMP's default wait spins at every barrier (libgomp
+# for some milliseconds, LLVM's libomp 200 ms) while the thread it waits for has no core: alone
+# OptimalFill.BeatsEdtAcrossShapesAndCounts takes 4.6 s, beside the other tests 32-107 s, and
+# the spinning took the CPU from the test beside it. Passive threads sleep at once (the CTest
+# stage: 551-672 s -> 384 s, docs/hardening.md). Results do not depend on it; timings only.
+export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-passive}"
 jobs="$(nproc)"
 stage_times=()
 timed() {
