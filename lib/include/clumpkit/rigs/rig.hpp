@@ -25,8 +25,9 @@ namespace clumpkit::rigs {
 /// wheel slice at `tiny` (12 mm arched above the throat); 2 = session 31's angle-of-repose fill
 /// when the tube cannot hold the mass (paper scale): the column fill ends once it trickles and
 /// the pour from above follows at once; 3 = session 33's paper-scale discharge: a 20 mm slice
-/// holding 10 kg per 100 mm, its hopper filled at 1 kg/s per 20 mm (was 100 mm, 10 kg, 0.04 kg/s).
-inline constexpr int kRigsRevision = 3;
+/// holding 10 kg per 100 mm, its hopper filled at 1 kg/s per 20 mm (was 100 mm, 10 kg, 0.04 kg/s);
+/// 4 = session 40's discharger pour box inside the hopper (its lower corners lay outside).
+inline constexpr int kRigsRevision = 4;
 /// The paper's discharger bed per length of pocket (10 kg in the 100 mm pocket, SPEC §7), kg/m:
 /// at paper scale a slice of the wheel holds this times its length.
 inline constexpr double kPaperBedPerLength = 100.0;
