@@ -42,6 +42,7 @@ for rpm in (10, 15, 30):
     d = load(f"dis_{rpm}")
     if d:
         discharges.append((rpm, d))
+        scale = scale or d.get("scale")  # a study of the discharger alone (--rigs discharge)
     m_, cv, mf = q(d, "pocket_mass"), q(d, "pocket_mass_cv"), q(d, "mass_flow")
     if m_:
         md.append(f"| production | {rpm} | {pm(m_, 3)} (n={m_[2]}) | {pm(cv, 3)} | {pm(mf, 3)} |")
