@@ -76,5 +76,15 @@ TEST(RigScale, AnUnknownRigIsNamed) {
   }
 }
 
+// Cached rig runs key on their rig's revision: a change to one rig (session 40 moved the
+// discharger's pour box) keeps the other rigs' cached runs, whose keys stay those of
+// revision 3.
+TEST(RigRevision, EachRigHasItsOwn) {
+  EXPECT_EQ(rig_revision("bulk_density"), 3);
+  EXPECT_EQ(rig_revision("angle_of_repose"), 3);
+  EXPECT_EQ(rig_revision("discharge"), 4);
+  EXPECT_EQ(rig_revision("discharge"), kDischargeRevision);
+}
+
 }  // namespace
 }  // namespace clumpkit::rigs

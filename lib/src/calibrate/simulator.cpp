@@ -104,8 +104,9 @@ RigSimulator::Entry RigSimulator::entry(const ParticleModel& model, const SimReq
                                         int repeats, std::uint64_t seed) const {
   Entry e;
   e.model = model_for_sample(model, req.sample, model.path.string());
-  e.key = fmt::format("{}|{}|{}|{}|engine {} rigs {}", req.key(), seed, repeats,
-                      model_fingerprint(e.model), dem::kPhysicsRevision, rigs::kRigsRevision);
+  e.key =
+      fmt::format("{}|{}|{}|{}|engine {} rigs {}", req.key(), seed, repeats,
+                  model_fingerprint(e.model), dem::kPhysicsRevision, rigs::rig_revision(req.rig));
   // The bundled runner's keys are as they always were (caches stay valid); LIGGGHTS's name it.
   if (opt_.engine != "clumpkit")
     e.key += fmt::format("|{} np {}", opt_.engine, std::max(1, opt_.liggghts_ranks));

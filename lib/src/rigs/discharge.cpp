@@ -33,7 +33,7 @@ std::string bed_fingerprint(const Ctx& c) {
       model_fingerprint(c.req.model), c.seed, c.req.rays, p.name, p.stiffness_scale,
       p.implicit_damping, p.rayleigh_fraction, p.settle_speed, p.settle_max, p.pour_rate,
       p.pour_whole_in_region, p.wheel_scale, p.slice_length, p.bed_mass, dem::kPhysicsRevision,
-      kRigsRevision);
+      kDischargeRevision);
 }
 
 // The bed is kept in the repeat's folder, bed/ (apart from the running checkpoints, which are

@@ -13,6 +13,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "clumpkit/rigs/catalogue.hpp"
@@ -21,13 +22,20 @@
 namespace clumpkit::rigs {
 
 /// Changes whenever a rig gives different results for the same model, settings, scale and seed
-/// (caches of rig results key on it, beside dem::kPhysicsRevision): 1 = session 30's 24 mm
-/// wheel slice at `tiny` (12 mm arched above the throat); 2 = session 31's angle-of-repose fill
-/// when the tube cannot hold the mass (paper scale): the column fill ends once it trickles and
-/// the pour from above follows at once; 3 = session 33's paper-scale discharge: a 20 mm slice
-/// holding 10 kg per 100 mm, its hopper filled at 1 kg/s per 20 mm (was 100 mm, 10 kg, 0.04 kg/s);
-/// 4 = session 40's discharger pour box inside the hopper (its lower corners lay outside).
-inline constexpr int kRigsRevision = 4;
+/// (caches of rig results key on it, beside dem::kPhysicsRevision). One counter for every rig
+/// until session 40: 1 = session 30's 24 mm wheel slice at `tiny` (12 mm arched above the
+/// throat); 2 = session 31's angle-of-repose fill when the tube cannot hold the mass (paper
+/// scale): the column fill ends once it trickles and the pour from above follows at once; 3 =
+/// session 33's paper-scale discharge: a 20 mm slice holding 10 kg per 100 mm, its hopper filled
+/// at 1 kg/s per 20 mm (was 100 mm, 10 kg, 0.04 kg/s). Since then each rig has its own
+/// (rig_revision), so that a change to one rig keeps the cached runs of the others.
+inline constexpr int kRigsRevision = 3;
+/// The discharger's: 4 = session 40's pour box inside the hopper (its lower corners lay outside).
+inline constexpr int kDischargeRevision = 4;
+/// The revision of one rig's results: kDischargeRevision for `discharge`, else kRigsRevision.
+inline int rig_revision(std::string_view rig) {
+  return rig == "discharge" ? kDischargeRevision : kRigsRevision;
+}
 /// The paper's discharger bed per length of pocket (10 kg in the 100 mm pocket, SPEC §7), kg/m:
 /// at paper scale a slice of the wheel holds this times its length.
 inline constexpr double kPaperBedPerLength = 100.0;
