@@ -28,7 +28,8 @@ namespace clumpkit::rigs {
 /// scale): the column fill ends once it trickles and the pour from above follows at once; 3 =
 /// session 33's paper-scale discharge: a 20 mm slice holding 10 kg per 100 mm, its hopper filled
 /// at 1 kg/s per 20 mm (was 100 mm, 10 kg, 0.04 kg/s). Since then each rig has its own
-/// (rig_revision), so that a change to one rig keeps the cached runs of the others.
+/// (rig_revision), so that a change to one rig keeps the cached runs of the others: this one is
+/// now the bulk density's and the angle of repose's.
 inline constexpr int kRigsRevision = 3;
 /// The discharger's, 3 as the others' until it changes on its own.
 inline constexpr int kDischargeRevision = 3;
