@@ -25,8 +25,17 @@ TEST(DischargeJam, PocketsThatStarveAreNamed) {
   EXPECT_NE(one.get<std::string>().find("pocket 2 closed"), std::string::npos);
 }
 
+// A wheel whose counted pockets all closed empty never received the flow.
+TEST(DischargeJam, AnEmptyWheelIsOne) {
+  for (const std::vector<double>& fills : {std::vector<double>{0.0, 0.0, 0.0}, {0.0}}) {
+    const nlohmann::json j = discharge_jam(fills);
+    ASSERT_TRUE(j.is_string());
+    EXPECT_NE(j.get<std::string>().find("no counted pocket received a pill"), std::string::npos);
+  }
+}
+
 // Ordinary runs: tiny's three seeds at 15 rpm (6.19 / 6.33 / 5.76 g ...) and mini's pocket
-// scatter of ~5-10 % are not jams; neither are one pocket, no pockets, or an empty wheel.
+// scatter of ~5-10 % are not jams; neither is one pocket with pills, nor no pocket counted.
 TEST(DischargeJam, OrdinaryFillsAreNot) {
   EXPECT_TRUE(discharge_jam({6.19e-3, 6.33e-3, 5.76e-3}).is_null());
   EXPECT_TRUE(discharge_jam({5.53e-3, 6.00e-3, 5.03e-3}).is_null());
@@ -34,7 +43,6 @@ TEST(DischargeJam, OrdinaryFillsAreNot) {
   EXPECT_TRUE(discharge_jam({0.010, 0.0026}).is_null());  // just over a quarter
   EXPECT_TRUE(discharge_jam({0.010}).is_null());
   EXPECT_TRUE(discharge_jam({}).is_null());
-  EXPECT_TRUE(discharge_jam({0.0, 0.0, 0.0}).is_null());
 }
 
 // The result carries the flag beside the observables, which stand as measured.

@@ -226,12 +226,16 @@ RepeatResult discharge_result(const ScaleParams& p, const WheelGeometry& g,
 // mini and tiny a few pills span it). A lab would clear the rig and run again; the run's values
 // stand as measured, and the JSON and the log say which pockets starved.
 nlohmann::json discharge_jam(const std::vector<double>& fills) {
-  if (fills.size() < 2) return nullptr;
+  if (fills.empty()) return nullptr;
   const double top = *std::max_element(fills.begin(), fills.end());
+  if (top <= 0.0)
+    return "no counted pocket received a pill: the flow into the wheel never started, most likely "
+           "an arch over the throat; a lab would clear the rig and run again";
+  if (fills.size() < 2) return nullptr;
   std::vector<int> starved;
   for (size_t k = 0; k < fills.size(); ++k)
     if (fills[k] < 0.25 * top) starved.push_back(static_cast<int>(k) + 1);
-  if (starved.empty() || top <= 0.0) return nullptr;
+  if (starved.empty()) return nullptr;
   return fmt::format(
       "counted pocket{} {} closed with less than a quarter of the fullest one's {:.4g} kg: the "
       "flow into the wheel stopped, most likely an arch over the throat; a lab would clear the "

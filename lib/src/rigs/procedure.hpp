@@ -155,9 +155,9 @@ double pocket_mass(const std::vector<Eigen::Vector3d>& centres, const std::vecto
 RepeatResult discharge_result(const ScaleParams& p, const WheelGeometry& g,
                               const std::vector<double>& fills, const std::vector<double>& curve_t,
                               const std::vector<double>& curve_m);
-/// Null, or why the counted pockets' fills (kg, in closing order) look like a jammed wheel: a
-/// pocket with under a quarter of the fullest one's mass (numbered from 1). In the result's
-/// details as `jam`.
+/// Null, or why the counted pockets' fills (kg, in closing order) look like a jammed wheel: no
+/// pocket received a pill, or a pocket has under a quarter of the fullest one's mass (numbered
+/// from 1). In the result's details as `jam`.
 nlohmann::json discharge_jam(const std::vector<double>& fills);
 
 /// The engine settings every rig starts from: the model's materials (stiffness scaled by the
