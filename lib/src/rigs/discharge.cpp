@@ -231,7 +231,6 @@ nlohmann::json discharge_jam(const std::vector<double>& fills) {
   if (top <= 0.0)
     return "no counted pocket received a pill: the flow into the wheel never started, most likely "
            "an arch over the throat; a lab would clear the rig and run again";
-  if (fills.size() < 2) return nullptr;
   std::vector<int> starved;
   for (size_t k = 0; k < fills.size(); ++k)
     if (fills[k] < 0.25 * top) starved.push_back(static_cast<int>(k) + 1);
@@ -332,7 +331,6 @@ RepeatResult discharge(Ctx& c) {
   snapshot(c, w, "discharged");
 
   RepeatResult r = discharge_result(p, g, fills, curve_t, curve_m);
-  if (!r.details["jam"].is_null()) c.say("warning: " + r.details["jam"].get<std::string>());
   r.details.update(nlohmann::json{{"settle_fill", state["settle_fill"]},
                                   {"bed", state.value("bed", nlohmann::json::object())},
                                   {"bed_from", state.value("bed_from", "")},

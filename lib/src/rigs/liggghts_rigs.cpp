@@ -332,7 +332,6 @@ RepeatResult liggghts_discharge(Ctx& c) {
     }
   }
   RepeatResult r = discharge_result(p, g, fills, curve_t, curve_m);
-  if (!r.details["jam"].is_null()) c.say("warning: " + r.details["jam"].get<std::string>());
   r.details["pills"] = pills;
   r.details.update(engine_json(c, deck, dir, folder, seconds));
   if (!c.dir.empty())

@@ -279,6 +279,9 @@ RigResult run_rig(const RigRequest& req) {
       res.error = fmt::format("repeat {} (seed {}): {}", k + 1, c.seed, e.what());
       break;
     }
+    // The discharger's jam flag (either engine's run): the values stand, the log warns.
+    if (const auto jam = r.details.find("jam"); jam != r.details.end() && jam->is_string())
+      c.say("warning: " + jam->get<std::string>());
     r.seed = c.seed;
     r.wall_seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
     r.details["wall_seconds"] = r.wall_seconds;
