@@ -172,6 +172,64 @@ TEST(World, FactoryReportsARegionTooSmall) {
   EXPECT_THROW((void)World::create(s), InputError);
 }
 
+// A box cut by two planes into a V (a hopper's inclined walls): the volume is the closed form's,
+// every sphere of every pill lies inside both cuts, the pills reach into the V's lower corner,
+// and cuts that leave no room for a pill, or a normal that is not a unit vector, are refused.
+TEST(World, FactoryKeepsEveryPillInsideABoxsCuts) {
+  const double w = 0.011, h = 0.05, margin = 0.001;
+  const Eigen::Vector3d left = Eigen::Vector3d(1, 0, 1).normalized();
+  const Eigen::Vector3d right = Eigen::Vector3d(-1, 0, 1).normalized();
+  // The V: |x| <= z - 0.005 - √2·margin, cut from the box |x|, |y| <= w, 0.005 <= z <= h.
+  BoxRegion v{Eigen::Vector3d(-w, -w, 0.005),
+              Eigen::Vector3d(w, w, h),
+              {{Eigen::Vector3d(0, 0, 0.005) + margin * left, left},
+               {Eigen::Vector3d(0, 0, 0.005) + margin * right, right}}};
+  // Closed form: its x-z section is a triangle of height w and base 2w on the tip at
+  // z = 0.005 + √2·margin, then a 2w-wide band up to h; the section times the box's 2w in y.
+  const double tip = 0.005 + std::sqrt(2.0) * margin;
+  const double exact = (w * w + 2 * w * (h - tip - w)) * 2 * w;
+  EXPECT_NEAR(region_volume(v), exact, 0.01 * exact);
+  EXPECT_NE(describe(v).find("cut by 2 planes"), std::string::npos) << describe(v);
+
+  WorldSettings s = pour(1);
+  s.factories[0].region = v;
+  s.factories[0].count = 60;
+  const World world = World::create(s);
+  ASSERT_EQ(world.clump_count(), 60);
+  const auto& p = world.sphere_positions();
+  const auto& r = world.sphere_radii();
+  double lowest = h;
+  for (size_t i = 0; i < p.size(); ++i) {
+    for (const HalfSpace& c : v.cuts)
+      EXPECT_GE((p[i] - c.point).dot(c.normal), r[i] - 1e-12) << "sphere " << i;
+    lowest = std::min(lowest, p[i].z());
+  }
+  // A 1 mm pill's spheres get within a few mm of the V's tip.
+  EXPECT_LT(lowest, tip + 0.005);
+  for (const auto& x : world.positions()) EXPECT_TRUE(region_contains(v, x));
+
+  // Cuts that leave the box no room for a pill: refused, naming the region.
+  s.factories[0].region = BoxRegion{Eigen::Vector3d(-w, -w, 0.005),
+                                    Eigen::Vector3d(w, w, h),
+                                    {{Eigen::Vector3d(0, 0, h - 0.001), Eigen::Vector3d::UnitZ()}}};
+  try {
+    (void)World::create(s);
+    FAIL() << "a 1 mm slab held a pill";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "factories[0].region");
+    EXPECT_NE(std::string(e.what()).find("cut by a plane"), std::string::npos) << e.what();
+  }
+  s.factories[0].region = BoxRegion{Eigen::Vector3d(-w, -w, 0.005),
+                                    Eigen::Vector3d(w, w, h),
+                                    {{Eigen::Vector3d(0, 0, 0.01), Eigen::Vector3d(0, 0, 2)}}};
+  try {
+    (void)World::create(s);
+    FAIL() << "a normal of length 2 was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "factories[0].region.cuts[0]");
+  }
+}
+
 // LIGGGHTS' all_in no: only the centre of mass must lie in the region, so a region not much
 // larger than a pill takes several times more pills per batch; walls and other pills are still
 // never overlapped.

@@ -190,6 +190,32 @@ TEST(LiggghtsDeck, WallsTemplatesAndSeeds) {
   EXPECT_EQ(int(seeds.size()), count);
 }
 
+// A box cut by planes (the discharger's pour region) is the intersection of a block with each
+// plane's inner side, and the insertion names the intersection.
+TEST(LiggghtsDeck, ACutBoxIsABlockIntersectedWithPlanes) {
+  const dem::WorldSettings ws = scene(dem::RollingModel::kCdt);
+  LiggghtsDeck deck(ws, box(), 0.0, 1e-5, 7, "test");
+  dem::FactorySettings f;
+  const Vector3d n = Vector3d(1, 0, 1).normalized();
+  f.region = dem::BoxRegion{
+      Vector3d(-0.02, -0.01, 0.03), Vector3d(0.02, 0.01, 0.08), {{Vector3d(0, 0, 0.03), n}}};
+  f.mixture = {{"A", 1.0}};
+  f.mass = 0.01;
+  deck.insert(f);
+  const std::string in = by_name(deck.files()).at("in.rig");
+  EXPECT_NE(in.find("region pour1_box block -0.02 0.02 -0.01 0.01 0.03 0.08 units box\n"),
+            std::string::npos)
+      << in;
+  const std::vector<double> plane = numbers_after(in, "region pour1_cut0 plane ");
+  ASSERT_EQ(plane.size(), 6u);
+  EXPECT_EQ(plane[2], 0.03);
+  EXPECT_NEAR(plane[3], n.x(), 1e-9);  // the deck's numbers have 10 digits
+  EXPECT_NEAR(plane[5], n.z(), 1e-9);
+  EXPECT_NE(in.find("side in units box\n"), std::string::npos);
+  EXPECT_NE(in.find("region pour1 intersect 2 pour1_box pour1_cut0\n"), std::string::npos);
+  EXPECT_NE(in.find("region pour1\n"), std::string::npos);  // the insert/pack line's end
+}
+
 // Every `jump SELF L` lands on a `label L` of the same file, every `jump FILE [L]` on a file of
 // the deck (and its label), and no file has a label twice.
 void expect_jumps_land(const std::map<std::string, std::string>& files) {

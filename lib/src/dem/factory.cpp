@@ -1,10 +1,13 @@
-// Factories: random, non-overlapping insertion of clumps into box or cylinder regions.
+// Factories: random, non-overlapping insertion of clumps into box (optionally cut by planes) or
+// cylinder regions.
 #include "clumpkit/dem/factory.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
+#include <string>
 #include <unordered_map>
 
 #include "clumpkit/core/error.hpp"
@@ -12,8 +15,33 @@
 
 namespace clumpkit::dem {
 
+bool region_contains(const Region& r, const Eigen::Vector3d& p, double margin) {
+  if (const auto* b = std::get_if<BoxRegion>(&r)) {
+    if ((p.array() - b->min.array() < margin).any() || (b->max.array() - p.array() < margin).any())
+      return false;
+    for (const HalfSpace& h : b->cuts)
+      if ((p - h.point).dot(h.normal) < margin) return false;
+    return true;
+  }
+  const auto& c = std::get<CylinderRegion>(r);
+  const Eigen::Vector3d d = p - c.base_center;
+  return d.z() >= margin && c.height - d.z() >= margin && c.radius - d.head<2>().norm() >= margin;
+}
+
 double region_volume(const Region& r) {
-  if (const auto* b = std::get_if<BoxRegion>(&r)) return (b->max - b->min).prod();
+  if (const auto* b = std::get_if<BoxRegion>(&r)) {
+    const Eigen::Vector3d size = b->max - b->min;
+    if (b->cuts.empty()) return size.prod();
+    const int n = 64;
+    long in = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        for (int k = 0; k < n; ++k) {
+          const Eigen::Vector3d f((i + 0.5) / n, (j + 0.5) / n, (k + 0.5) / n);
+          in += region_contains(r, b->min + size.cwiseProduct(f)) ? 1 : 0;
+        }
+    return size.prod() * double(in) / double(n * n * n);
+  }
   const auto& c = std::get<CylinderRegion>(r);
   return std::numbers::pi * c.radius * c.radius * c.height;
 }
@@ -23,6 +51,10 @@ std::string describe(const Region& r) {
   if (const auto* b = std::get_if<BoxRegion>(&r)) {
     const Eigen::Vector3d d = (b->max - b->min) * 1e3;
     std::snprintf(buf, sizeof buf, "box %.4g x %.4g x %.4g mm", d.x(), d.y(), d.z());
+    const size_t n = b->cuts.size();
+    if (n > 0)
+      return buf +
+             (n == 1 ? std::string(" cut by a plane") : " cut by " + std::to_string(n) + " planes");
   } else {
     const auto& c = std::get<CylinderRegion>(r);
     std::snprintf(buf, sizeof buf, "cylinder D %.4g mm x H %.4g mm", 2e3 * c.radius,
@@ -46,15 +78,22 @@ Eigen::Quaterniond random_rotation(std::mt19937_64& rng) {
 }
 
 // A centre of mass at which a clump of bounding radius `bound` lies inside the region (0: a
-// centre anywhere in it).
-Eigen::Vector3d random_point(const Region& region, double bound, std::mt19937_64& rng) {
+// centre anywhere in it). A box's cuts are met by rejection: none when 32 draws in a row fall
+// beyond a cut (the attempt then counts as failed).
+std::optional<Eigen::Vector3d> random_point(const Region& region, double bound,
+                                            std::mt19937_64& rng) {
   if (const auto* b = std::get_if<BoxRegion>(&region)) {
-    Eigen::Vector3d p;
-    for (int k = 0; k < 3; ++k) {
-      const double lo = b->min[k] + bound, hi = b->max[k] - bound;
-      p[k] = lo + (hi - lo) * uniform(rng);
+    for (int draw = 0; draw < 32; ++draw) {
+      Eigen::Vector3d p;
+      for (int k = 0; k < 3; ++k) {
+        const double lo = b->min[k] + bound, hi = b->max[k] - bound;
+        p[k] = lo + (hi - lo) * uniform(rng);
+      }
+      bool in = true;
+      for (const HalfSpace& h : b->cuts) in = in && (p - h.point).dot(h.normal) >= bound;
+      if (in) return p;
     }
-    return p;
+    return std::nullopt;
   }
   const auto& c = std::get<CylinderRegion>(region);
   const double rr = std::max(0.0, c.radius - bound);
@@ -176,8 +215,13 @@ void World::Impl::run_factories() {
       }
       bool ok = false;
       for (int attempt = 0; attempt < f.s.attempts_per_clump && !ok; ++attempt) {
-        const Eigen::Vector3d x =
+        const std::optional<Eigen::Vector3d> xo =
             random_point(region, f.s.whole_in_region ? td.bound_radius : 0.0, f.rng);
+        if (!xo) {
+          ++f.status.failed_attempts;
+          continue;
+        }
+        const Eigen::Vector3d x = *xo;
         const Eigen::Quaterniond q =
             f.s.random_orientation ? random_rotation(f.rng) : Eigen::Quaterniond::Identity();
         const Eigen::Matrix3d R = q.toRotationMatrix();

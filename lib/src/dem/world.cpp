@@ -105,6 +105,22 @@ FactoryRuntime make_factory(const World::Impl& w, const WorldSettings& s, const 
     if (!b->min.allFinite() || !b->max.allFinite() || !((b->max - b->min).minCoeff() > 0.0))
       throw InputError(where, f + ".region", "box min must be below max on every axis");
     fits = (b->max - b->min).minCoeff() >= 2.0 * bound;
+    for (size_t h = 0; h < b->cuts.size(); ++h)
+      if (!b->cuts[h].point.allFinite() || !b->cuts[h].normal.allFinite() ||
+          !(std::abs(b->cuts[h].normal.norm() - 1.0) < 1e-9))
+        throw InputError(where, f + ".region.cuts[" + std::to_string(h) + "]",
+                         "needs a finite point and a unit normal");
+    if (fits && !b->cuts.empty()) {
+      // Somewhere in the cut box a whole clump must fit: search a 32³ grid for such a centre.
+      fits = false;
+      const int n = 32;
+      for (int i = 0; i < n && !fits; ++i)
+        for (int j = 0; j < n && !fits; ++j)
+          for (int l = 0; l < n && !fits; ++l) {
+            const Eigen::Vector3d u((i + 0.5) / n, (j + 0.5) / n, (l + 0.5) / n);
+            fits = region_contains(fs.region, b->min + (b->max - b->min).cwiseProduct(u), bound);
+          }
+    }
   } else {
     const auto& c = std::get<CylinderRegion>(fs.region);
     if (!(c.radius > 0.0) || !(c.height > 0.0) || !c.base_center.allFinite())

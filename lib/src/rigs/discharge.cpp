@@ -116,13 +116,20 @@ DischargeScene discharge_scene(const Ctx& c) {
                                  p.name, cap, p.bed_mass));
   const double zt = g.throat_z();
   const double ymax = 0.5 * g.length - 0.0005;
-  // Known defect (docs/rigs.md, "The pour box"): the box's lower corners lie beyond the inclined
-  // walls, ~10 % of it, and the pills placed there fall past the hopper (leaked_before_start_kg).
-  // Starting the box higher, inside the hopper, raises every pill's fall; with softened pills
-  // that pinched more of them and jammed a discharge (bench/tried/pour_box_inside_hopper.diff).
+  // The pour region: the box over the hopper from 0.4 of its inclined part's height up, cut by
+  // the inclined walls' planes 2 mm inside them. (Until session 41 the box was not cut: its lower
+  // corners, ~10 % of it, lay beyond the walls and the pills placed there fell past the hopper.
+  // Starting a plain box higher, inside the walls, raised every pill's fall instead, and with
+  // softened pills that jammed a discharge: bench/tried/pour_box_inside_hopper.diff.)
+  const double cos_a = std::cos(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
+  const double sin_a = std::sin(g.hopper_half_angle_deg * std::numbers::pi / 180.0);
+  const double w0 = 0.5 * g.hopper_opening, margin = 0.002;
+  const Vector3d into_left(cos_a, 0, sin_a), into_right(-cos_a, 0, sin_a);
   const dem::BoxRegion box{
-      Vector3d(-0.5 * g.hopper_top_width + 0.002, -ymax, zt + 0.4 * hc),
-      Vector3d(0.5 * g.hopper_top_width - 0.002, ymax, zt + hc + g.hopper_height)};
+      Vector3d(-0.5 * g.hopper_top_width + margin, -ymax, zt + 0.4 * hc),
+      Vector3d(0.5 * g.hopper_top_width - margin, ymax, zt + hc + g.hopper_height),
+      {{Vector3d(-w0, 0, zt) + margin * into_left, into_left},
+       {Vector3d(w0, 0, zt) + margin * into_right, into_right}}};
   dem::FactorySettings fill = pour(c, box, p.bed_mass);
   // Poured at a rate (paper scale: the bed does not fit the region at once), the hopper fills to
   // its top: the paper's 10 kg per 100 mm nearly fills it, and a slice between end plates packs

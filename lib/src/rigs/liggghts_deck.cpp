@@ -60,8 +60,21 @@ std::string region_command(const std::string& id, const dem::Region& r) {
                        g(c->base_center.y()), g(c->radius), g(c->base_center.z()),
                        g(c->base_center.z() + c->height));
   const auto& b = std::get<dem::BoxRegion>(r);
-  return fmt::format("region {} block {} {} {} {} {} {} units box", id, g(b.min.x()), g(b.max.x()),
-                     g(b.min.y()), g(b.max.y()), g(b.min.z()), g(b.max.z()));
+  const std::string box = b.cuts.empty() ? id : id + "_box";
+  std::string out =
+      fmt::format("region {} block {} {} {} {} {} {} units box", box, g(b.min.x()), g(b.max.x()),
+                  g(b.min.y()), g(b.max.y()), g(b.min.z()), g(b.max.z()));
+  if (b.cuts.empty()) return out;
+  // A box cut by planes: the intersection of the block with each plane's inner side.
+  std::string parts = box;
+  for (size_t k = 0; k < b.cuts.size(); ++k) {
+    const dem::HalfSpace& h = b.cuts[k];
+    out += fmt::format("\nregion {}_cut{} plane {} {} {} {} {} {} side in units box", id, k,
+                       g(h.point.x()), g(h.point.y()), g(h.point.z()), g(h.normal.x()),
+                       g(h.normal.y()), g(h.normal.z()));
+    parts += fmt::format(" {}_cut{}", id, k);
+  }
+  return out + fmt::format("\nregion {} intersect {} {}", id, b.cuts.size() + 1, parts);
 }
 
 double region_height(const dem::Region& r) {

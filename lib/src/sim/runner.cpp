@@ -11,6 +11,7 @@
 
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
+#include "clumpkit/dem/factory.hpp"
 #include "clumpkit/sim/vtk_output.hpp"
 
 namespace clumpkit::sim {
@@ -24,14 +25,6 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) {
   g_stop.store(true);
-}
-
-bool inside(const dem::Region& r, const Eigen::Vector3d& p) {
-  if (const auto* b = std::get_if<dem::BoxRegion>(&r))
-    return (p.array() >= b->min.array()).all() && (p.array() <= b->max.array()).all();
-  const auto& c = std::get<dem::CylinderRegion>(r);
-  const Eigen::Vector3d d = p - c.base_center;
-  return d.z() >= 0 && d.z() <= c.height && d.head<2>().norm() <= c.radius;
 }
 
 std::string duration(double s) {
@@ -131,7 +124,7 @@ class Runner {
     for (const auto& r : scene_.regions) {
       double m = 0;
       for (int c = 0; c < w.clump_count(); ++c)
-        if (inside(r.region, w.positions()[c])) m += w.clump_mass(c);
+        if (dem::region_contains(r.region, w.positions()[c])) m += w.clump_mass(c);
       row += fmt::format(",{:.9g}", m);
     }
     for (int k = 0; k < w.wall_count(); ++k) {

@@ -31,8 +31,8 @@ namespace clumpkit::rigs {
 /// (rig_revision), so that a change to one rig keeps the cached runs of the others: this one is
 /// now the bulk density's and the angle of repose's.
 inline constexpr int kRigsRevision = 3;
-/// The discharger's, 3 as the others' until it changes on its own.
-inline constexpr int kDischargeRevision = 3;
+/// The discharger's: 4 since session 41 (its pour region cut by the hopper's walls).
+inline constexpr int kDischargeRevision = 4;
 /// The revision of one rig's results: kDischargeRevision for `discharge`, else kRigsRevision.
 inline int rig_revision(std::string_view rig) {
   return rig == "discharge" ? kDischargeRevision : kRigsRevision;
