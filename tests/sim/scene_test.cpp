@@ -95,6 +95,31 @@ TEST(Scene, BadScenesNameFileAndField) {
   }
 }
 
+// A box region cut by a plane: the cut is read with its units and its normal made unit, and a
+// zero normal is named.
+TEST(Scene, ABoxRegionMayBeCutByPlanes) {
+  const fs::path d = temp_dir("cut");
+  write_file_atomic(d / "s.toml",
+                    kBase +
+                        "[[factories]]\nregion = { kind = \"box\", min = \"-9 -9 0 mm\", max = "
+                        "\"9 9 30 mm\", cuts = [{ point = \"0 0 5 mm\", normal = \"1 0 1\" }] }\n"
+                        "count = 3\nmixture = [{ clump = \"B12\" }]\n");
+  const sim::Scene s = sim::load_scene(d / "s.toml", kData);
+  fs::remove_all(d);
+  ASSERT_EQ(s.world.factories.size(), 1u);
+  const auto& b = std::get<dem::BoxRegion>(s.world.factories[0].region);
+  ASSERT_EQ(b.cuts.size(), 1u);
+  EXPECT_NEAR(b.cuts[0].point.z(), 0.005, 1e-15);
+  EXPECT_NEAR(b.cuts[0].normal.x(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(b.cuts[0].normal.norm(), 1.0, 1e-15);
+  const std::string e =
+      error_of(kBase +
+               "[[factories]]\nregion = { kind = \"box\", min = \"-9 -9 0 mm\", max = \"9 9 30 "
+               "mm\", cuts = [{ point = \"0 0 5 mm\", normal = \"0 0 0\" }] }\n"
+               "count = 3\nmixture = [{ clump = \"B12\" }]\n");
+  EXPECT_NE(e.find("factories.0.region.cuts.0.normal: must not be zero"), std::string::npos) << e;
+}
+
 TEST(Runner, WritesSeriesVtkAndFinishedState) {
   sim::Scene s = sim::load_scene(kData / "tests/sim/small_pour.toml", kData);
   s.until = 0.04;

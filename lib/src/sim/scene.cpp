@@ -18,6 +18,16 @@ dem::Region parse_region(const TomlDoc& doc, const std::string& key) {
     b.max = doc.vector(key + ".max", Dimension::Length);
     if ((b.max.array() <= b.min.array()).any())
       doc.fail(key + ".max", "must exceed min in every coordinate");
+    // cuts = [{ point = "...", normal = "..." }, ...]: the box's part on each normal's side.
+    for (size_t i = 0; i < doc.array_size(key + ".cuts"); ++i) {
+      const std::string c = key + ".cuts." + std::to_string(i);
+      dem::HalfSpace h;
+      h.point = doc.vector(c + ".point", Dimension::Length);
+      h.normal = doc.vector(c + ".normal", Dimension::Dimensionless);
+      if (!(h.normal.norm() > 0.0)) doc.fail(c + ".normal", "must not be zero");
+      h.normal.normalize();
+      b.cuts.push_back(h);
+    }
     return b;
   }
   if (kind == "cylinder") {
