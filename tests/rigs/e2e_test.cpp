@@ -194,7 +194,7 @@ TEST(RigEndToEnd, DischargeFillsThePockets) {
   // Stopped at the fill's last checks and resumed: the bits of the uninterrupted run, the mass
   // that leaked from the hopper during the fill included (the settle's checkpoint keeps it).
   // Since session 41 the pour region is cut by the hopper's walls, so none leaks (before, the
-  // tiny fill lost ~3 g of its 50: docs/rigs.md, "The pour region").
+  // tiny fill lost ~3 g of its 50: docs/rigs.md, "The pour region since session 41").
   const double leaked = d.at("leaked_before_start_kg").get<double>();
   EXPECT_EQ(leaked, 0.0);
   EXPECT_NEAR(d.at("bed").at("at_rest_kg").get<double>(), 0.05, 0.001);
