@@ -118,6 +118,15 @@ TEST(Scene, ABoxRegionMayBeCutByPlanes) {
                "mm\", cuts = [{ point = \"0 0 5 mm\", normal = \"0 0 0\" }] }\n"
                "count = 3\nmixture = [{ clump = \"B12\" }]\n");
   EXPECT_NE(e.find("factories.0.region.cuts.0.normal: must not be zero"), std::string::npos) << e;
+  // Every placement tried tests every cut: more than 16 are refused.
+  std::string many;
+  for (int k = 0; k < 17; ++k)
+    many += std::string(k ? ", " : "") + "{ point = \"0 0 1 mm\", normal = \"0 0 1\" }";
+  const std::string e17 = error_of(kBase +
+                                   "[[factories]]\nregion = { kind = \"box\", min = \"-9 -9 0 "
+                                   "mm\", max = \"9 9 30 mm\", cuts = [" +
+                                   many + "] }\ncount = 3\nmixture = [{ clump = \"B12\" }]\n");
+  EXPECT_NE(e17.find("factories.0.region.cuts: 17 planes; at most 16"), std::string::npos) << e17;
 }
 
 TEST(Runner, WritesSeriesVtkAndFinishedState) {

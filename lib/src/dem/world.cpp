@@ -105,6 +105,10 @@ FactoryRuntime make_factory(const World::Impl& w, const WorldSettings& s, const 
     if (!b->min.allFinite() || !b->max.allFinite() || !((b->max - b->min).minCoeff() > 0.0))
       throw InputError(where, f + ".region", "box min must be below max on every axis");
     fits = (b->max - b->min).minCoeff() >= 2.0 * bound;
+    if (b->cuts.size() > kMaxRegionCuts)
+      throw InputError(
+          where, f + ".region.cuts",
+          std::to_string(b->cuts.size()) + " planes; at most " + std::to_string(kMaxRegionCuts));
     for (size_t h = 0; h < b->cuts.size(); ++h)
       if (!b->cuts[h].point.allFinite() || !b->cuts[h].normal.allFinite() ||
           !(std::abs(b->cuts[h].normal.norm() - 1.0) < 1e-9))

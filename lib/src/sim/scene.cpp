@@ -19,7 +19,11 @@ dem::Region parse_region(const TomlDoc& doc, const std::string& key) {
     if ((b.max.array() <= b.min.array()).any())
       doc.fail(key + ".max", "must exceed min in every coordinate");
     // cuts = [{ point = "...", normal = "..." }, ...]: the box's part on each normal's side.
-    for (size_t i = 0; i < doc.array_size(key + ".cuts"); ++i) {
+    const size_t cuts = doc.array_size(key + ".cuts");
+    if (cuts > dem::kMaxRegionCuts)
+      doc.fail(key + ".cuts",
+               std::to_string(cuts) + " planes; at most " + std::to_string(dem::kMaxRegionCuts));
+    for (size_t i = 0; i < cuts; ++i) {
       const std::string c = key + ".cuts." + std::to_string(i);
       dem::HalfSpace h;
       h.point = doc.vector(c + ".point", Dimension::Length);

@@ -3,6 +3,7 @@
 /// at once or at a rate, random positions and orientations, non-overlapping, template mixture by
 /// mass fraction.
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <utility>
@@ -16,6 +17,9 @@ struct HalfSpace {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< a point of the plane, m
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, into the kept side
 };
+
+/// A box region takes at most this many cuts (each is tested for every placement tried).
+inline constexpr size_t kMaxRegionCuts = 16;
 
 struct BoxRegion {
   BoxRegion() = default;
