@@ -41,8 +41,8 @@ struct CylinderRegion {
 
 using Region = std::variant<BoxRegion, CylinderRegion>;
 
-/// Exact for boxes and cylinders; a box with cuts is integrated on a 64³ midpoint grid (0.08 %
-/// off the closed form for the V-cut box of World.FactoryKeepsEveryPillInsideABoxsCuts).
+/// Exact for boxes and cylinders; a box with cuts is integrated on a 64³ midpoint grid (within
+/// 1 % of the closed form for the V-cut box of World.FactoryKeepsEveryPillInsideABoxsCuts).
 double region_volume(const Region& r);
 std::string describe(const Region& r);  ///< e.g. "box 20 x 20 x 20 mm"
 /// Whether `p` lies in the region at least `margin` from its boundary (margin 0: in it at all).
