@@ -1,8 +1,14 @@
 // The discharger's observables from the counted pockets' fills, and the jam flag (procedure.hpp).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
 #include <string>
 #include <vector>
+
+#include "clumpkit/core/error.hpp"
 
 #include "clumpkit/rigs/geometry.hpp"
 #include "clumpkit/rigs/rig.hpp"
@@ -55,6 +61,82 @@ TEST(DischargeJam, TheResultCarriesIt) {
   EXPECT_NEAR(jammed.values.at("pocket_mass_cv"), 1.57, 0.01);
   const RepeatResult fine = discharge_result(p, g, {0.0108, 0.0101, 0.0095}, {}, {});
   EXPECT_TRUE(fine.details.at("jam").is_null());
+}
+
+// A stand-in for one discharge: the wheel jams for the seeds in `jams`, else flows.
+RepeatResult fake_discharge(const Ctx& c, const std::vector<std::uint64_t>& jams,
+                            std::vector<std::uint64_t>& seeds, std::vector<std::string>& dirs) {
+  seeds.push_back(c.seed);
+  dirs.push_back(c.dir.filename().string());
+  const bool jam = std::find(jams.begin(), jams.end(), c.seed) != jams.end();
+  RepeatResult r;
+  r.values["pocket_mass"] = jam ? 0.0 : 0.17;
+  r.details["jam"] = jam ? nlohmann::json("no counted pocket received a pill") : nlohmann::json();
+  return r;
+}
+
+// A jammed wheel is run again from a fresh fill with another seed, in its own folder, as a lab
+// clears the rig; the result says which attempts jammed and which seed flowed.
+TEST(DischargeJam, AJammedRepeatIsRunAgainWithAnotherSeed) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("clumpkit_jam_retry_test_" + std::to_string(::getpid())) /
+                                    "repeat_1";
+  std::filesystem::remove_all(dir.parent_path());
+  std::filesystem::create_directories(dir);
+  RigRequest req;
+  std::vector<std::string> said;
+  req.progress = [&](const std::string& s) { said.push_back(s); };
+  Ctx c{req, rig_scale("discharge", {{"scale", "tiny"}}), {}, dir, 7, 0};
+  std::vector<std::uint64_t> seeds;
+  std::vector<std::string> dirs;
+  const RepeatResult r =
+      run_attempts(c, [&](Ctx& a) { return fake_discharge(a, {7}, seeds, dirs); });
+  EXPECT_EQ(seeds, (std::vector<std::uint64_t>{7, 7 + kJamSeedStep}));
+  EXPECT_EQ(dirs, (std::vector<std::string>{"repeat_1", "retry_1"}));
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "retry_1"));
+  EXPECT_DOUBLE_EQ(r.values.at("pocket_mass"), 0.17);
+  ASSERT_EQ(r.details.at("jammed").size(), 1u);
+  EXPECT_EQ(r.details.at("jammed")[0].at("seed"), 7u);
+  EXPECT_EQ(r.details.at("seed_used"), 7u + kJamSeedStep);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_NE(said[0].find("running again from a fresh fill with seed 1007"), std::string::npos)
+      << said[0];
+
+  // A wheel that flows at once: one attempt, no record of retries.
+  seeds.clear();
+  dirs.clear();
+  const RepeatResult fine =
+      run_attempts(c, [&](Ctx& a) { return fake_discharge(a, {}, seeds, dirs); });
+  EXPECT_EQ(seeds.size(), 1u);
+  EXPECT_FALSE(fine.details.contains("jammed"));
+  std::filesystem::remove_all(dir.parent_path());
+}
+
+// Every attempt jammed: the repeat fails, naming the seeds; with --bed-from nothing is retried.
+TEST(DischargeJam, EveryAttemptJammedIsAFailure) {
+  RigRequest req;
+  Ctx c{req, rig_scale("discharge", {{"scale", "tiny"}}), {}, {}, 1, 0};
+  std::vector<std::uint64_t> seeds;
+  std::vector<std::string> dirs;
+  const std::vector<std::uint64_t> all = {1, 1 + kJamSeedStep, 1 + 2 * kJamSeedStep};
+  try {
+    run_attempts(c, [&](Ctx& a) { return fake_discharge(a, all, seeds, dirs); });
+    FAIL() << "no error";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("jammed in all 3 attempts (seeds 1, 1001, 2001)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(seeds, all);
+  EXPECT_EQ(kJamAttempts, 3);
+
+  req.bed_from = "earlier_run";
+  seeds.clear();
+  const RepeatResult kept =
+      run_attempts(c, [&](Ctx& a) { return fake_discharge(a, all, seeds, dirs); });
+  EXPECT_EQ(seeds.size(), 1u);
+  EXPECT_TRUE(kept.details.at("jam").is_string());
+  EXPECT_EQ(kept.details.at("jammed").size(), 1u);
 }
 
 }  // namespace

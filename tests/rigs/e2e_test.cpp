@@ -6,6 +6,8 @@
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/rigs/rig.hpp"
@@ -144,6 +146,33 @@ TEST(RigEndToEnd, AngleOfReposeTubeStopsOnceTheHeapRestsClearOfIt) {
   EXPECT_EQ(rb.stats.at("angle").mean, a.stats.at("angle").mean);
   EXPECT_EQ(rb.repeats[0].details.at("lift_m"), d.at("lift_m"));
   EXPECT_EQ(rb.repeats[0].details.at("lift_stop"), d.at("lift_stop"));
+}
+
+// A strongly cohesive model arches over the throat: a counted pocket starves. The repeat is run
+// again from fresh fills with two more seeds, as a lab clears the rig; all three jam here, so
+// the repeat fails naming the seeds and keeps no result, and each attempt had its own folder.
+// Stronger still, the cohesion squeezes the poured pills into each other until the engine
+// releases them all as pinched: a bed with nothing to discharge is refused.
+TEST(RigEndToEnd, AWheelThatJamsInEveryAttemptFails) {
+  RigRequest q = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge_jam");
+  q.model.effects.cohesion = 2e5;
+  std::vector<std::string> retries;
+  q.progress = [&](const std::string& line) {
+    if (line.find("running again from a fresh fill") != std::string::npos) retries.push_back(line);
+  };
+  const RigResult r = run_rig(q);
+  EXPECT_TRUE(r.repeats.empty());
+  EXPECT_NE(r.error.find("jammed in all 3 attempts (seeds 1, 1001, 2001)"), std::string::npos)
+      << r.error;
+  EXPECT_EQ(retries.size(), 2u);
+  EXPECT_TRUE(fs::exists(q.out / "repeat_1" / "retry_2" / "bed" / "bed.ckpt"));
+  EXPECT_FALSE(fs::exists(q.out / "repeat_1" / "result.json"));
+
+  RigRequest pinched = request("discharge", "scale=tiny;rpm=30;pockets=2", "e2e_discharge_lump");
+  pinched.model.effects.cohesion = 5e5;
+  const RigResult p = run_rig(pinched);
+  EXPECT_TRUE(p.repeats.empty());
+  EXPECT_NE(p.error.find("nothing to discharge"), std::string::npos) << p.error;
 }
 
 // The wheel at 30 rpm through two measured pockets. Pills caught between a vane tip and the

@@ -272,6 +272,15 @@ RepeatResult discharge(Ctx& c) {
       state = take_bed(c, w);
     } else {
       const SettleInfo s1 = pour_and_settle(c, w, "fill hopper");
+      // A bed that lost most of what was poured has nothing to discharge: a strongly cohesive
+      // model squeezes its pills into each other until the engine releases them as pinched
+      // (cohesion 5e5 J/m^3 at tiny: 50 g poured, none left).
+      const double poured = w.factory_status(0).inserted_mass;
+      if (w.total_mass() < 0.5 * poured)
+        throw NumericalError(fmt::format(
+            "fill hopper: the bed holds {:.4g} kg of the {:.4g} kg poured ({:.4g} kg fell "
+            "through the outlet, {:.4g} kg was released as pinched): nothing to discharge",
+            w.total_mass(), poured, c.removed_mass, w.pinched_mass()));
       snapshot(c, w, "bed");
       // Pills that leaked through the outlet while the wheel stood still are not counted.
       state = {{"t_action", w.time() + 0.01},

@@ -160,6 +160,15 @@ RepeatResult discharge_result(const ScaleParams& p, const WheelGeometry& g,
 /// from 1). In the result's details as `jam`.
 nlohmann::json discharge_jam(const std::vector<double>& fills);
 
+/// One repeat through `run`, run again while its result carries the jam flag (discharge_jam),
+/// as a lab clears the rig and runs again: from a fresh fill with the seed + kJamSeedStep ×
+/// attempt, in the repeat's folder's retry_A/ (A = 1, 2, ...), kJamAttempts in all. A result
+/// after a jam lists the jammed attempts in its details (`jammed`: seed and why) and the seed
+/// that flowed (`seed_used`). Every attempt jammed: NumericalError naming the seeds (the
+/// pockets starved, so the values stand for no flow of the model). With --bed-from the bed is
+/// given and a jam is kept, flagged, not run again.
+RepeatResult run_attempts(Ctx& c, const std::function<RepeatResult(Ctx&)>& run);
+
 /// The engine settings every rig starts from: the model's materials (stiffness scaled by the
 /// scale), clump types and contact laws against `wall_materials`, the scale's step and damping.
 dem::WorldSettings base_settings(const Ctx& c, const std::vector<std::string>& wall_materials);

@@ -1,6 +1,7 @@
 #include "clumpkit/rigs/rig.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cmath>
@@ -208,6 +209,56 @@ void check_engine(const std::string& engine, int ranks) {
   if (engine == "liggghts") detail::require_liggghts(ranks);
 }
 
+namespace {
+
+RepeatResult run_once(detail::Ctx& c, const std::string& rig) {
+  if (c.req.engine == "liggghts") return detail::liggghts_repeat(c);
+  if (rig == "bulk_density") return detail::bulk_density(c);
+  if (rig == "angle_of_repose") return detail::angle_of_repose(c);
+  return detail::discharge(c);
+}
+
+}  // namespace
+
+RepeatResult detail::run_attempts(Ctx& c, const std::function<RepeatResult(Ctx&)>& run) {
+  nlohmann::json jammed = nlohmann::json::array();
+  const std::uint64_t seed0 = c.seed;
+  const fs::path dir0 = c.dir;
+  for (int attempt = 0;; ++attempt) {
+    Ctx a{c.req, c.p, c.types, dir0, seed0 + kJamSeedStep * std::uint64_t(attempt), c.repeat};
+    if (attempt > 0 && !dir0.empty()) {
+      a.dir = dir0 / fmt::format("retry_{}", attempt);
+      fs::create_directories(a.dir);
+    }
+    RepeatResult r = run(a);
+    const auto jam = r.details.find("jam");
+    if (jam == r.details.end() || !jam->is_string()) {
+      if (!jammed.empty()) {
+        r.details["jammed"] = jammed;
+        r.details["seed_used"] = a.seed;
+      }
+      return r;
+    }
+    const std::string why = jam->get<std::string>();
+    jammed.push_back({{"seed", a.seed}, {"jam", why}});
+    if (!c.req.bed_from.empty()) {
+      a.say("warning: " + why + " (the bed is given by --bed-from: not run again)");
+      r.details["jammed"] = jammed;
+      return r;
+    }
+    if (attempt + 1 >= kJamAttempts) {
+      std::vector<std::uint64_t> seeds;
+      for (const auto& j : jammed) seeds.push_back(j.at("seed").get<std::uint64_t>());
+      throw NumericalError(
+          fmt::format("the wheel jammed in all {} attempts (seeds {}): {}; the model arches over "
+                      "the throat at this scale and speed",
+                      kJamAttempts, fmt::join(seeds, ", "), why));
+    }
+    a.say(fmt::format("warning: {}; running again from a fresh fill with seed {}", why,
+                      seed0 + kJamSeedStep * std::uint64_t(attempt + 1)));
+  }
+}
+
 RigResult run_rig(const RigRequest& req) {
   const RigInfo& info = find_rig(req.rig, "", "rig");
   RigResult res;
@@ -267,21 +318,11 @@ RigResult run_rig(const RigRequest& req) {
     const auto t_start = Clock::now();
     RepeatResult r;
     try {
-      if (req.engine == "liggghts")
-        r = detail::liggghts_repeat(c);
-      else if (info.name == "bulk_density")
-        r = detail::bulk_density(c);
-      else if (info.name == "angle_of_repose")
-        r = detail::angle_of_repose(c);
-      else
-        r = detail::discharge(c);
+      r = detail::run_attempts(c, [&](detail::Ctx& a) { return run_once(a, info.name); });
     } catch (const NumericalError& e) {
       res.error = fmt::format("repeat {} (seed {}): {}", k + 1, c.seed, e.what());
       break;
     }
-    // The discharger's jam flag (either engine's run): the values stand, the log warns.
-    if (const auto jam = r.details.find("jam"); jam != r.details.end() && jam->is_string())
-      c.say("warning: " + jam->get<std::string>());
     r.seed = c.seed;
     r.wall_seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
     r.details["wall_seconds"] = r.wall_seconds;

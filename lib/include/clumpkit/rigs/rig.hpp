@@ -31,8 +31,14 @@ namespace clumpkit::rigs {
 /// (rig_revision), so that a change to one rig keeps the cached runs of the others: this one is
 /// now the bulk density's and the angle of repose's.
 inline constexpr int kRigsRevision = 3;
-/// The discharger's: 4 since session 41 (its pour region cut by the hopper's walls).
-inline constexpr int kDischargeRevision = 4;
+/// The discharger's: 4 since session 41 (its pour region cut by the hopper's walls); 5 since
+/// session 42 (a jammed wheel is run again from a fresh fill, kJamAttempts in all: only runs
+/// that jammed change).
+inline constexpr int kDischargeRevision = 5;
+/// Attempts of a discharge repeat whose wheel jams (run_rig): the first with the repeat's seed,
+/// each further one from a fresh fill with kJamSeedStep more.
+inline constexpr int kJamAttempts = 3;
+inline constexpr std::uint64_t kJamSeedStep = 1000;
 /// The revision of one rig's results: kDischargeRevision for `discharge`, else kRigsRevision.
 inline int rig_revision(std::string_view rig) {
   return rig == "discharge" ? kDischargeRevision : kRigsRevision;
