@@ -1,8 +1,12 @@
 // clumpkit rig: run one of the paper's validation rigs with a particle model (SPEC §7).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "cli_util.hpp"
 #include "clumpkit/core/atomic_file.hpp"
@@ -173,8 +177,11 @@ Command setup_rig(CLI::App& parent) {
             std::cout << fmt::format("{} with model {} at scale {} ({}), {} repeat(s)\n", r.rig,
                                      r.model, r.scale, format_settings(r.settings),
                                      r.repeats.size());
-            std::cout << fmt::format("{:<16} {:>12} {:>12} {:>3}  {}\n", "quantity", "mean", "std",
-                                     "n", "unit");
+            if (r.repeats.empty())
+              std::cout << "no repeat finished\n";
+            else
+              std::cout << fmt::format("{:<16} {:>12} {:>12} {:>3}  {}\n", "quantity", "mean",
+                                       "std", "n", "unit");
             for (const auto& q : info.quantities) {
               const auto it = r.stats.find(q.name);
               if (it == r.stats.end()) continue;
@@ -182,9 +189,21 @@ Command setup_rig(CLI::App& parent) {
                                        it->second.mean / q.to_si, it->second.std / q.to_si,
                                        it->second.n, q.unit);
             }
-            for (const auto& rep : r.repeats)
-              std::cout << fmt::format("  seed {}: {:.1f} s wall{}\n", rep.seed, rep.wall_seconds,
-                                       rep.resumed ? " (kept from an earlier run)" : "");
+            for (const auto& rep : r.repeats) {
+              // A repeat run again after a jam (rigs::detail::run_attempts) says so.
+              std::string retried;
+              if (const auto j = rep.details.find("jammed"); j != rep.details.end()) {
+                std::vector<std::uint64_t> seeds;
+                for (const auto& e : *j) seeds.push_back(e.at("seed").get<std::uint64_t>());
+                retried = fmt::format(", the wheel jammed with seed{} {}",
+                                      seeds.size() == 1 ? "" : "s", fmt::join(seeds, ", "));
+                if (rep.details.contains("seed_used"))
+                  retried += fmt::format(" and flowed with {}",
+                                         rep.details.at("seed_used").get<std::uint64_t>());
+              }
+              std::cout << fmt::format("  seed {}: {:.1f} s wall{}{}\n", rep.seed, rep.wall_seconds,
+                                       retried, rep.resumed ? " (kept from an earlier run)" : "");
+            }
             if (!a->json.empty()) write_json(r.to_json(), a->json);
             if (!r.error.empty()) {
               std::cerr << "clumpkit rig: " << r.error

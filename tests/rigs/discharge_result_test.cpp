@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "clumpkit/core/error.hpp"
-
 #include "clumpkit/rigs/geometry.hpp"
 #include "clumpkit/rigs/rig.hpp"
 #include "rigs/procedure.hpp"
