@@ -230,8 +230,8 @@ RepeatResult discharge_result(const ScaleParams& p, const WheelGeometry& g,
 
 // A counted pocket that closed with under a quarter of the fullest one's mass: the flow into the
 // wheel stopped or nearly stopped, most likely an arch over the throat (in the 24 mm slice of
-// mini and tiny a few pills span it). A lab would clear the rig and run again; the run's values
-// stand as measured, and the JSON and the log say which pockets starved.
+// mini and tiny a few pills span it). A lab would clear the rig and run again, and so does
+// run_rig (detail::run_attempts); the JSON and the log say which pockets starved.
 nlohmann::json discharge_jam(const std::vector<double>& fills) {
   if (fills.empty()) return nullptr;
   const double top = *std::max_element(fills.begin(), fills.end());
