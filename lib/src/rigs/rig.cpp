@@ -221,19 +221,19 @@ RepeatResult run_once(detail::Ctx& c, const std::string& rig) {
 }  // namespace
 
 RepeatResult detail::run_attempts(Ctx& c, const std::function<RepeatResult(Ctx&)>& run) {
+  auto seed_of = [&c](int attempt) { return c.seed + kJamSeedStep * std::uint64_t(attempt); };
   nlohmann::json jammed = nlohmann::json::array();
-  const std::uint64_t seed0 = c.seed;
-  const fs::path dir0 = c.dir;
+  std::vector<std::uint64_t> seeds;  // of the attempts that jammed
   for (int attempt = 0;; ++attempt) {
-    Ctx a{c.req, c.p, c.types, dir0, seed0 + kJamSeedStep * std::uint64_t(attempt), c.repeat};
-    if (attempt > 0 && !dir0.empty()) {
-      a.dir = dir0 / fmt::format("retry_{}", attempt);
+    Ctx a{c.req, c.p, c.types, c.dir, seed_of(attempt), c.repeat};
+    if (attempt > 0 && !c.dir.empty()) {
+      a.dir = c.dir / fmt::format("retry_{}", attempt);
       fs::create_directories(a.dir);
     }
     RepeatResult r = run(a);
     const auto jam = r.details.find("jam");
     if (jam == r.details.end() || !jam->is_string()) {
-      if (!jammed.empty()) {
+      if (!seeds.empty()) {
         r.details["jammed"] = jammed;
         r.details["seed_used"] = a.seed;
       }
@@ -241,21 +241,19 @@ RepeatResult detail::run_attempts(Ctx& c, const std::function<RepeatResult(Ctx&)
     }
     const std::string why = jam->get<std::string>();
     jammed.push_back({{"seed", a.seed}, {"jam", why}});
+    seeds.push_back(a.seed);
     if (!c.req.bed_from.empty()) {
       a.say("warning: " + why + " (the bed is given by --bed-from: not run again)");
       r.details["jammed"] = jammed;
       return r;
     }
-    if (attempt + 1 >= kJamAttempts) {
-      std::vector<std::uint64_t> seeds;
-      for (const auto& j : jammed) seeds.push_back(j.at("seed").get<std::uint64_t>());
+    if (attempt + 1 >= kJamAttempts)
       throw NumericalError(
           fmt::format("the wheel jammed in all {} attempts (seeds {}): {}; the model arches over "
                       "the throat at this scale and speed",
                       kJamAttempts, fmt::join(seeds, ", "), why));
-    }
     a.say(fmt::format("warning: {}; running again from a fresh fill with seed {}", why,
-                      seed0 + kJamSeedStep * std::uint64_t(attempt + 1)));
+                      seed_of(attempt + 1)));
   }
 }
 
