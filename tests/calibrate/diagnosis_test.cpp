@@ -115,7 +115,7 @@ TEST(Diagnosis, FindsEachHiddenEffect) {
 // between its points trapped the fit at its extremum.
 TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
   const int trials = 40;
-  int covered = 0, covered95 = 0, first = 0;
+  int covered = 0, covered95 = 0, first = 0, covered1 = 0;
   for (int t = 0; t < trials; ++t) {
     fake::FakeSimulator sim;
     sim.noise_rel = 0.08;
@@ -151,17 +151,24 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
     first += top.candidate.effect == "rolling_friction";
     covered += top.candidate.effect == "rolling_friction" &&
                std::abs(top.fitted - 0.2) <= 2.0 * top.fitted_std;
+    covered1 +=
+        top.candidate.effect == "rolling_friction" && std::abs(top.fitted - 0.2) <= top.fitted_std;
     covered95 +=
         top.candidate.effect == "rolling_friction" && top.fitted_lo <= 0.2 && 0.2 <= top.fitted_hi;
   }
   EXPECT_EQ(first, trials);
   std::cout << "rolling friction ranked first in " << first << " of " << trials
             << " trials, truth within 2 stated sigma in " << covered
-            << ", within the 95 % interval in " << covered95 << "\n";
+            << ", within the 95 % interval in " << covered95 << ", within 1 stated sigma in "
+            << covered1 << "\n";
   EXPECT_GE(covered95, 34) << covered95 << " of " << trials << " in the 95 % interval";
   // Nominal 2-sigma coverage is 95 % (38 of 40); measured 37 (38 before session 14's local
   // surrogate). With a two-repeat spread and an interpolating surrogate it was 19 of 40.
   EXPECT_GE(covered, 34) << covered << " of " << trials << " cover the truth";
+  // Nominal 1-sigma coverage is 68 % (27 of 40, binomial spread ~3); measured 26 (session 43).
+  // A stated sigma that is too small shows here first (issue 7: the fitted strength within its
+  // stated uncertainty of the truth).
+  EXPECT_GE(covered1, 22) << covered1 << " of " << trials << " within 1 stated sigma";
 }
 
 TEST(Diagnosis, NoFalseVerdictWhenNothingIsMissing) {
