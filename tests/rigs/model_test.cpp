@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "clumpkit/core/error.hpp"
+#include "clumpkit/geometry/clump_template.hpp"
 #include "clumpkit/rigs/model.hpp"
 
 namespace clumpkit {
@@ -108,6 +110,37 @@ TEST(Model, MassBasisScalesMassAndInertiaTogether) {
   const double f = ct[0].clump.mass.mass / cu[0].clump.mass.mass;
   EXPECT_NEAR(ct[0].clump.mass.principal_moments[2] / cu[0].clump.mass.principal_moments[2], f,
               1e-9);
+}
+
+// A type given as a clump template (from `clumpkit fill` of any mesh) still names its shape
+// file, for the material and density: the union's mass is the template's volume at that
+// density, whatever density the template was filled at. Without a shape file the error says why.
+TEST(Model, AClumpTemplateTakesItsShapeFilesDensity) {
+  const fs::path dir = fs::temp_directory_path() / "clumpkit_model_template_test";
+  fs::create_directories(dir);
+  {
+    std::ofstream f(dir / "grain.toml");
+    f << "[shape]\nkind = \"mesh\"\nfile = \"grain.stl\"\nunits = \"mm\"\n"
+         "[material]\nname = \"pill\"\ndensity = \"1200 kg/m^3\"\n";
+  }
+  const std::string clump = CLUMPKIT_SOURCE_DIR "/tests/fuzz/corpus/clump_json/A4.json";
+  const std::string head = "[model]\nname = \"g\"\nmaterials = \"" CLUMPKIT_SOURCE_DIR
+                           "/shapes/materials.toml\"\n[[types]]\nname = \"G\"\n";
+  const std::string tail = "clump = \"" + clump + "\"\n[effects]\nrestitution = true\n";
+  const ParticleModel m =
+      parse_model(head + "shape = \"grain.toml\"\n" + tail, dir / "g.toml", dir);
+  const ClumpTemplate filled = load_clump(clump);  // filled at 1380 kg/m^3
+  ASSERT_EQ(filled.mass.density, 1380.0);
+  const auto types = m.clump_types(4000);
+  const double volume = filled.mass.mass / filled.mass.density;
+  EXPECT_NEAR(types[0].clump.mass.mass, volume * 1200.0, 1e-12 * volume * 1200.0);
+  EXPECT_NEAR(types[0].clump.mass.principal_moments[0] / filled.mass.principal_moments[0],
+              1200.0 / 1380.0, 1e-12);
+  const std::string e = error_from([&] { parse_model(head + tail, dir / "g.toml", dir); });
+  EXPECT_NE(e.find("types.0.shape"), std::string::npos) << e;
+  EXPECT_NE(e.find("shape file"), std::string::npos) << e;
+  EXPECT_NE(e.find("clump template"), std::string::npos) << e;
+  fs::remove_all(dir);
 }
 
 // A height spread (size_distribution): each type becomes three height classes whose

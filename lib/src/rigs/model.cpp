@@ -172,6 +172,10 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
     t.name = doc.string(p + "name");
     if (t.name.empty() || !names.insert(t.name).second)
       doc.fail(p + "name", "type names must be non-empty and unique");
+    if (!doc.has(p + "shape"))
+      doc.fail(p + "shape",
+               "missing: every type needs a shape file (its outline, kind = \"cylinder\" or "
+               "\"mesh\", its material and density), also a type given as a clump template");
     const std::string shape = doc.string(p + "shape");
     t.shape_path = resolve(shape, base, data_dir);
     if (!path_exists(t.shape_path)) doc.fail(p + "shape", "file '" + shape + "' not found");
@@ -374,8 +378,13 @@ std::vector<dem::ClumpTypeSettings> ParticleModel::clump_types(long rays) const 
       c = load_clump(t.clump_path);
     }
     // Mass basis: scale mass and inertia together (the union's mass distribution is kept).
+    // The union's mass is its volume at the density of the type's shape file, also for a
+    // template filled at another density (`clumpkit fill` defaults to 1380 kg/m^3).
     double target = c.mass.mass;
-    if (mass_basis == MassBasis::kTrueShape) {
+    if (mass_basis == MassBasis::kSphereUnion && c.mass.density > 0.0 &&
+        c.mass.density != t.shape.density) {
+      target = c.mass.mass / c.mass.density * t.shape.density;
+    } else if (mass_basis == MassBasis::kTrueShape) {
       if (t.shape.kind != ShapeSpec::Kind::Cylinder)
         throw InputError(path.string(), "model.mass_basis",
                          "true_shape needs cylinder shapes (type " + t.name + ")");
@@ -573,9 +582,11 @@ std::string model_fingerprint(const ParticleModel& m) {
     s << "type " << t.name << " " << t.shape.diameter << " " << t.shape.height << " "
       << t.shape.density << " " << t.mass_fraction << " " << t.paper_spheres.value_or(0) << " "
       << t.given_mass.value_or(0.0) << " ";
+    // "@shape-density": since session 43 a template's union mass is at the shape file's
+    // density (results cached before were made at the template's own).
     if (!t.clump_path.empty())
       s << read_file(t.clump_path).size() << ":"
-        << std::hash<std::string>{}(read_file(t.clump_path));
+        << std::hash<std::string>{}(read_file(t.clump_path)) << "@shape-density";
     s << "\n";
   }
   const ModelEffects& e = m.effects;
