@@ -122,5 +122,43 @@ TEST(EffectCandidates, AUniformOrAbsentBaselineGivesUniformVariants) {
   }
 }
 
+TEST(EffectCandidates, ShapeResolutionOfAClumpTemplateIsTheOptimisersLadder) {
+  // A paper-rule model keeps its rule's presets (the flat pill A: 4, 12, 20).
+  const ParticleModel a12 = load_model(kModels / "paper_A12.toml");
+  const EffectCandidate paper =
+      find(effect_candidates(a12, {"shape_resolution"}, nullptr), "shape_resolution");
+  EXPECT_EQ(paper.baseline, 12);
+  EXPECT_EQ(paper.levels, (std::vector<double>{4, 20}));
+  // A type given as a clump template (a 4-sphere pill A from `clumpkit fill`) is filled again by
+  // the optimiser at 2, 4, 8, 16, 32 spheres, less its own count. Before session 43 the
+  // candidate was skipped ("a type uses a clump template").
+  const fs::path dir = fs::temp_directory_path() / "clumpkit_effects_template_test";
+  fs::create_directories(dir);
+  const std::string head =
+      "[model]\nname = \"t\"\nmaterials = \"" CLUMPKIT_SOURCE_DIR "/shapes/materials.toml\"\n";
+  const std::string templ = "[[types]]\nname = \"T\"\nshape = \"" CLUMPKIT_SOURCE_DIR
+                            "/shapes/pill_A.toml\"\nclump = \"" CLUMPKIT_SOURCE_DIR
+                            "/tests/fuzz/corpus/clump_json/A4.json\"\nmass_fraction = 0.5\n";
+  const ParticleModel t =
+      parse_model(head + templ + "[effects]\nrestitution = true\n", dir / "t.toml", dir);
+  const EffectCandidate opt =
+      find(effect_candidates(t, {"shape_resolution"}, nullptr), "shape_resolution");
+  EXPECT_EQ(opt.baseline, 4);
+  EXPECT_EQ(opt.levels, (std::vector<double>{2, 8, 16, 32}));
+  EXPECT_NE(opt.parameter.find("optimiser"), std::string::npos) << opt.parameter;
+  // Both in one model: the counts both can take (4), less the current 12.
+  const ParticleModel mixed =
+      parse_model(head +
+                      "[[types]]\nname = \"A\"\nshape = \"" CLUMPKIT_SOURCE_DIR
+                      "/shapes/pill_A.toml\"\npaper_spheres = 12\nmass_fraction = 0.5\n" +
+                      templ + "[effects]\nrestitution = true\nsize_distribution = true\n",
+                  dir / "m.toml", dir);
+  const EffectCandidate both =
+      find(effect_candidates(mixed, {"shape_resolution"}, nullptr), "shape_resolution");
+  EXPECT_EQ(both.baseline, 12);
+  EXPECT_EQ(both.levels, (std::vector<double>{4}));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace clumpkit::calibrate

@@ -143,6 +143,36 @@ TEST(Model, AClumpTemplateTakesItsShapeFilesDensity) {
   fs::remove_all(dir);
 }
 
+// shape_resolution on a type given as a clump template: its shape filled again by the optimiser
+// at that count, at the shape file's density, the same bits every time (a rig run's model).
+TEST(Model, AClumpTemplateAtAnotherResolutionIsFilledAgainByTheOptimiser) {
+  const fs::path dir = fs::temp_directory_path() / "clumpkit_model_refill_test";
+  fs::create_directories(dir);
+  const ParticleModel m = parse_model(
+      "[model]\nname = \"t\"\nmaterials = \"" CLUMPKIT_SOURCE_DIR
+      "/shapes/materials.toml\"\n[[types]]\nname = \"T\"\nshape = \"" CLUMPKIT_SOURCE_DIR
+      "/shapes/pill_A.toml\"\nclump = \"" CLUMPKIT_SOURCE_DIR
+      "/tests/fuzz/corpus/clump_json/A4.json\"\n[effects]\nshape_resolution = { spheres = 8 "
+      "}\n",
+      dir / "t.toml", dir);
+  const auto a = m.clump_types(20000), b = m.clump_types(20000);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].clump.spheres.size(), 8u);
+  EXPECT_EQ(a[0].clump.method.value("name", ""), "optimal");
+  EXPECT_EQ(a[0].clump.mass.density, 1380.0);  // pill_A.toml's
+  for (size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(a[0].clump.spheres[i].center, b[0].clump.spheres[i].center) << i;
+    EXPECT_EQ(a[0].clump.spheres[i].radius, b[0].clump.spheres[i].radius) << i;
+  }
+  // 8 optimised spheres hold more of the pill than the paper's 4 (0.673 of the cylinder) and
+  // stay inside it but for the fill's tolerance.
+  const double cylinder = M_PI * 0.25 * 0.006 * 0.006 * 0.0054;
+  EXPECT_GT(a[0].clump.mass.volume, 0.70 * cylinder);
+  EXPECT_LT(a[0].clump.mass.volume, 1.02 * cylinder);
+  EXPECT_NE(m.summary().find("8-sphere (optimiser)"), std::string::npos) << m.summary();
+  fs::remove_all(dir);
+}
+
 // A height spread (size_distribution): each type becomes three height classes whose
 // mass-weighted heights have the type's height as mean and the spread as relative std, each filled
 // by the type's paper rule so that its outer spheres touch its own end faces.

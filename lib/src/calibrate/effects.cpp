@@ -7,6 +7,7 @@
 
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/fill/paper_rule.hpp"
+#include "clumpkit/geometry/clump_template.hpp"
 
 namespace clumpkit::calibrate {
 
@@ -148,13 +149,22 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
   continuous("cohesion", "SJKR energy density, pill-pill", "J/m^3", 0.0, 5e4,
              fx.cohesion.value_or(0.0), 8e3);
   if (wanted("shape_resolution")) {
-    // Sphere counts every paper-rule type of the model has a preset for.
+    // The sphere counts every type can take: a paper-rule type its rule's presets; a type given
+    // as a clump template (from `clumpkit fill` of a mesh or cylinder) is filled again by the
+    // optimiser, at a ladder of counts.
+    static const std::set<int> kOptimiserCounts = {2, 4, 8, 16, 32};
     std::set<int> common;
-    bool first = true, all_paper = !base.types.empty();
+    bool first = true;
+    int current = fx.shape_resolution.value_or(0);
     for (const auto& t : base.types) {
-      if (!t.paper_spheres && !fx.shape_resolution) all_paper = false;
-      const auto counts = paper_preset_counts(regime(t.shape.diameter, t.shape.height));
-      std::set<int> s(counts.begin(), counts.end());
+      std::set<int> s = kOptimiserCounts;
+      if (t.paper_spheres) {
+        const auto counts = paper_preset_counts(regime(t.shape.diameter, t.shape.height));
+        s = std::set<int>(counts.begin(), counts.end());
+        if (current == 0) current = *t.paper_spheres;
+      } else if (current == 0) {
+        current = static_cast<int>(load_clump(t.clump_path).spheres.size());
+      }
       if (first)
         common = s;
       else {
@@ -165,17 +175,15 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       }
       first = false;
     }
-    const int current = fx.shape_resolution.value_or(
-        base.types.empty() ? 0 : base.types.front().paper_spheres.value_or(0));
     common.erase(current);
-    if (!all_paper) {
-      skip("shape_resolution", "a type uses a clump template, not a paper rule");
-    } else if (common.empty()) {
-      skip("shape_resolution", "no other paper-rule sphere count fits every type");
+    if (common.empty()) {
+      skip("shape_resolution",
+           "no other sphere count fits every type (paper-rule types: their "
+           "rule's presets; clump templates: 2, 4, 8, 16, 32 by the optimiser)");
     } else {
       EffectCandidate c;
       c.effect = "shape_resolution";
-      c.parameter = "spheres per clump (paper rule)";
+      c.parameter = "spheres per clump (paper rule, or the optimiser for a clump template)";
       c.unit = "spheres";
       c.discrete = true;
       c.baseline = current;

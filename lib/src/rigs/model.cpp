@@ -10,8 +10,10 @@
 #include "clumpkit/core/atomic_file.hpp"
 #include "clumpkit/core/error.hpp"
 #include "clumpkit/core/toml_doc.hpp"
+#include "clumpkit/fill/fill_problem.hpp"
 #include "clumpkit/fill/paper_fill.hpp"
 #include "clumpkit/geometry/mass_properties.hpp"
+#include "clumpkit/raycast/target_shape.hpp"
 
 namespace clumpkit {
 
@@ -90,7 +92,7 @@ std::string height_spread_blocker(const ParticleModel& m) {
   for (const ModelType& t : m.types) {
     if (t.shape.kind != ShapeSpec::Kind::Cylinder)
       return "a height spread needs cylinder shapes (type " + t.name + " is a mesh)";
-    if (!t.paper_spheres && !m.effects.shape_resolution)
+    if (!t.paper_spheres)
       return "a height spread refills each height class by the paper rule (type " + t.name +
              " uses a clump template)";
   }
@@ -279,7 +281,9 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
   }
   if (effect_listed(doc, "shape_resolution", tbl)) {
     if (!tbl || !doc.has("effects.shape_resolution.spheres"))
-      doc.fail("effects.shape_resolution", "shape_resolution needs spheres = N (paper-rule count)");
+      doc.fail("effects.shape_resolution",
+               "shape_resolution needs spheres = N (the paper rule's count for a paper-rule "
+               "type; a type given as a clump template is filled again by the optimiser)");
     const long long n = doc.integer("effects.shape_resolution.spheres");
     doc.require_range("effects.shape_resolution.spheres", double(n), 1, 1000);
     fx.shape_resolution = int(n);
@@ -353,11 +357,41 @@ std::vector<ModelType> ParticleModel::population() const {
   return out;
 }
 
+namespace {
+
+// A type given as a clump template, at another sphere count (shape_resolution): its shape (a
+// mesh or a cylinder) filled again by the optimiser (`clumpkit fill SHAPE --method optimal
+// --spheres N`, one thread, seed 1), at the shape file's density. The same model gives the same
+// clump bits.
+ClumpTemplate refill_template_type(const ModelType& t, int spheres, long rays) {
+  TargetShape target = target_from_shape(t.shape);
+  std::shared_ptr<const SurfaceSolid> solid(std::move(target.solid));
+  const FillShape shape = fill_shape_with_surface_distance(
+      solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); },
+      t.shape_path.string());
+  FillOptions o;
+  o.spheres = spheres;
+  o.threads = 1;  // the rig runs of a diagnosis already run side by side
+  validate_fill_options(o);
+  const FillResult r = optimal_fill(shape, o);
+  RaySamplingOptions sampling;
+  sampling.rays = rays;
+  sampling.seed = o.seed + 7919;  // as `clumpkit fill`: independent of the fill's own rays
+  ClumpTemplate c = fill_template("optimal", o, r, measure_fill(shape, r.spheres, sampling),
+                                  t.shape.density, sampling);
+  c.source = {{"file", t.shape_path.string()}};
+  return c;
+}
+
+}  // namespace
+
 std::vector<dem::ClumpTypeSettings> ParticleModel::clump_types(long rays) const {
   std::vector<dem::ClumpTypeSettings> out;
   for (const ModelType& t : population()) {
     ClumpTemplate c;
-    if (t.paper_spheres || effects.shape_resolution) {
+    if (effects.shape_resolution && !t.paper_spheres && !t.clump_path.empty()) {
+      c = refill_template_type(t, *effects.shape_resolution, rays);
+    } else if (t.paper_spheres) {
       PaperFillRequest req;
       req.spheres = effects.shape_resolution ? *effects.shape_resolution : *t.paper_spheres;
       // A height class keeps its type's rule (the regime of the type's own height).
@@ -370,10 +404,7 @@ std::vector<dem::ClumpTypeSettings> ParticleModel::clump_types(long rays) const 
         }
       }
       req.sampling.rays = rays;
-      if (t.clump_path.empty() || effects.shape_resolution)
-        c = paper_fill_template(t.shape, req);
-      else
-        c = load_clump(t.clump_path);
+      c = paper_fill_template(t.shape, req);
     } else {
       c = load_clump(t.clump_path);
     }
@@ -457,10 +488,12 @@ std::vector<dem::MixtureEntry> ParticleModel::mixture() const {
 std::string ParticleModel::summary() const {
   std::string s = fmt::format("model {} ({} basis):", name, to_string(mass_basis));
   for (const auto& t : types)
-    s += fmt::format(" {} {:.0f}% {}", t.name, 100.0 * t.mass_fraction,
-                     effects.shape_resolution ? fmt::format("{}-sphere", *effects.shape_resolution)
-                     : t.paper_spheres        ? fmt::format("{}-sphere", *t.paper_spheres)
-                                              : t.clump_path.filename().string());
+    s +=
+        fmt::format(" {} {:.0f}% {}", t.name, 100.0 * t.mass_fraction,
+                    effects.shape_resolution ? fmt::format("{}-sphere{}", *effects.shape_resolution,
+                                                           t.paper_spheres ? "" : " (optimiser)")
+                    : t.paper_spheres        ? fmt::format("{}-sphere", *t.paper_spheres)
+                                             : t.clump_path.filename().string());
   s += "; effects on:";
   for (const auto& e : effect_names())
     if (effects.on(e)) s += " " + e;
