@@ -170,6 +170,20 @@ TEST(Model, AClumpTemplateAtAnotherResolutionIsFilledAgainByTheOptimiser) {
   EXPECT_GT(a[0].clump.mass.volume, 0.70 * cylinder);
   EXPECT_LT(a[0].clump.mass.volume, 1.02 * cylinder);
   EXPECT_NE(m.summary().find("8-sphere (optimiser)"), std::string::npos) << m.summary();
+  // A mesh shape's bytes are part of the model (cached runs of its refills go when it changes).
+  {
+    std::ofstream(dir / "g.stl") << "solid g\nendsolid g\n";
+    std::ofstream(dir / "g.toml") << "[shape]\nkind = \"mesh\"\nfile = \"g.stl\"\n"
+                                     "[material]\ndensity = \"1200 kg/m^3\"\n";
+  }
+  const std::string text = "[model]\nname = \"g\"\nmaterials = \"" CLUMPKIT_SOURCE_DIR
+                           "/shapes/materials.toml\"\n[[types]]\nname = \"G\"\nshape = "
+                           "\"g.toml\"\nclump = \"" CLUMPKIT_SOURCE_DIR
+                           "/tests/fuzz/corpus/clump_json/A4.json\"\n[effects]\nrestitution = "
+                           "true\n";
+  const std::string before = model_fingerprint(parse_model(text, dir / "g_model.toml", dir));
+  std::ofstream(dir / "g.stl") << "solid g2\nendsolid g2\n";
+  EXPECT_NE(model_fingerprint(parse_model(text, dir / "g_model.toml", dir)), before);
   fs::remove_all(dir);
 }
 
