@@ -623,7 +623,8 @@ std::string model_fingerprint(const ParticleModel& m) {
     // A mesh shape is what shape_resolution fills again: its bytes and scale are the model's.
     if (t.shape.kind == ShapeSpec::Kind::Mesh)
       s << " mesh " << t.shape.mesh_scale << " "
-        << (path_exists(t.shape.mesh) ? std::hash<std::string>{}(read_file(t.shape.mesh)) : 0);
+        << (path_exists(t.shape.mesh) ? std::hash<std::string>{}(read_file(t.shape.mesh))
+                                      : std::size_t{0});
     s << "\n";
   }
   const ModelEffects& e = m.effects;
