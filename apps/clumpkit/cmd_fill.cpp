@@ -56,10 +56,6 @@ void note_mesh(const TargetShape& t) {
 // of the library (`clumpkit mesh --list`). Sets `source` provenance and the density.
 FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& density) {
   namespace fs = std::filesystem;
-  auto from_surface = [](auto solid, const std::string& where) {
-    return fill_shape_with_surface_distance(
-        solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); }, where);
-  };
   std::error_code ec;
 #ifdef CLUMPKIT_HAVE_RAYCAST  // Embree is required (lib/src/raycast): every build has it
   if (is_mesh_file(a.shape)) {
@@ -73,7 +69,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
     std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
     source = {{"file", a.shape}, {"kind", "mesh"}, {"mesh_scale", scale}, {"units", a.mesh_units}};
     record_mesh_repairs(load, source);
-    return from_surface(solid, a.shape);
+    return fill_shape_with_surface_distance(solid, a.shape);
   }
 #endif
   const bool is_test = is_test_shape(a.shape);
@@ -116,7 +112,7 @@ FillShape general_shape(const FillArgs& a, nlohmann::json& source, double& densi
   source["mesh"] = spec.mesh.string();
   source["mesh_scale"] = spec.mesh_scale;
   record_mesh_repairs(spec, source);
-  return from_surface(solid, spec.path.string());
+  return fill_shape_with_surface_distance(solid, spec.path.string());
 #else
   throw InputError(spec.path.string(), "shape.kind", "this build has no mesh support (raycast)");
 #endif

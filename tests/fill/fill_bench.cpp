@@ -45,8 +45,7 @@ FillShape mesh_shape(const std::string& path) {
 #ifdef CLUMPKIT_BENCH_MESHES
   TargetShape t = target_from_mesh(path, 1.0);
   std::shared_ptr<const SurfaceSolid> solid(std::move(t.solid));
-  return fill_shape_with_surface_distance(  // as clumpkit fill does
-      solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); }, path);
+  return fill_shape_with_surface_distance(solid, path);  // as clumpkit fill does
 #else
   (void)path;
   std::fprintf(stderr, "fill_bench: built without mesh support\n");

@@ -366,9 +366,7 @@ namespace {
 ClumpTemplate refill_template_type(const ModelType& t, int spheres, long rays) {
   TargetShape target = target_from_shape(t.shape);
   std::shared_ptr<const SurfaceSolid> solid(std::move(target.solid));
-  const FillShape shape = fill_shape_with_surface_distance(
-      solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); },
-      t.shape_path.string());
+  const FillShape shape = fill_shape_with_surface_distance(solid, t.shape_path.string());
   FillOptions o;
   o.spheres = spheres;
   o.threads = 1;  // the rig runs of a diagnosis already run side by side

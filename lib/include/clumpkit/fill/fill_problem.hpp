@@ -31,6 +31,15 @@ FillShape fill_shape_with_surface_distance(
     std::shared_ptr<const RaySolid> solid,
     std::function<double(const Eigen::Vector3d&)> surface_distance, std::string where);
 
+/// The same for a solid that measures its own surface distance (raycast's SurfaceSolid: a mesh
+/// or an analytic surface), as `clumpkit fill` and a model's shape_resolution refill use it.
+template <class Solid>
+FillShape fill_shape_with_surface_distance(std::shared_ptr<const Solid> solid, std::string where) {
+  return fill_shape_with_surface_distance(
+      solid, [solid](const Eigen::Vector3d& p) { return solid->surface_distance(p); },
+      std::move(where));
+}
+
 enum class FillMetric { SymmetricDifference, Volume, Inertia };
 const char* to_string(FillMetric m);
 /// "symmetric_difference" | "volume" | "inertia"; throws InputError(field "--metric").
