@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <iostream>
+#include <optional>
 #include <random>
 #include <set>
 #include <thread>
@@ -161,10 +162,8 @@ Command setup_compare(CLI::App& parent) {
             warn_redundant(ms, a->measurements);
             std::vector<ParticleModel> models;
             for (const auto& m : a->models) models.push_back(load_model(find_model(m), data_dir()));
-            if (!a->report.empty()) {
-              std::error_code ec;
-              std::filesystem::create_directories(a->report, ec);
-            }
+            std::optional<OutputFolder> report_folder;  // gone again if no report is written
+            if (!a->report.empty()) report_folder.emplace(a->report, "--report");
             check_outputs(*a);
             RigSimulator sim = make_sim(*a);
             ReportInput rep;
@@ -253,10 +252,8 @@ Command setup_diagnose(CLI::App& parent) {
         if (a->apply && a->output.empty())
           throw InputError("", "--output", "--apply needs -o NEW_MODEL.toml");
         if (!a->output.empty()) check_writable(a->output, "--output");
-        if (!a->report.empty()) {
-          std::error_code ec;
-          std::filesystem::create_directories(a->report, ec);
-        }
+        std::optional<OutputFolder> report_folder;  // gone again if no report is written
+        if (!a->report.empty()) report_folder.emplace(a->report, "--report");
         check_outputs(*a);
         DiagnoseOptions o;
         o.scale = a->scale;

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "cli_util.hpp"
 #include "clumpkit/core/atomic_file.hpp"
@@ -32,11 +33,8 @@ Command setup_paper(CLI::App& parent) {
   return {c, [args] {
             namespace fs = std::filesystem;
             if (!args->json.empty() && args->json != "-") check_writable(args->json, "--json");
-            if (!args->out.empty()) {
-              std::error_code ec;
-              fs::create_directories(args->out, ec);
-              check_writable(fs::path(args->out) / "x.json", "--out");
-            }
+            std::optional<OutputFolder> out_folder;  // gone again if nothing is written
+            if (!args->out.empty()) out_folder.emplace(args->out, "--out");
             nlohmann::json rows = nlohmann::json::array();
             std::cout << fmt::format(
                 "{:<6} {:>7} {:>8} {:>10} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "model",

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -164,10 +165,9 @@ Command setup_rig(CLI::App& parent) {
               throw InputError("--vtk", "", "VTK output needs --out DIR");
             // Scale parameters are checked before anything is written or the long run starts.
             (void)rigs::rig_scale(req.rig, req.settings);
+            std::optional<OutputFolder> out_folder;  // gone again if the run writes nothing
             if (!a->out.empty()) {
-              std::error_code ec;
-              fs::create_directories(a->out, ec);
-              check_writable(fs::path(a->out) / "x.json", "--out");
+              out_folder.emplace(a->out, "--out");
               req.out = a->out;
             }
             if (!a->json.empty() && a->json != "-") check_writable(a->json, "--json");

@@ -823,3 +823,35 @@ TEST(Diagnosis, TwoHiddenEffectsAreFoundTogether) {
       0.01)
       << d1.summary();
 }
+
+// A mixture of several pill types whose lab sample held another share of each type than the model
+// file says: size_distribution's mass-fraction candidate (the first type's share, the others in
+// their ratios) is ranked first, fitted within its stated uncertainty, and the model it writes is
+// consistent with the data.
+TEST(Diagnosis, FindsAHiddenMixtureFraction) {
+  const ParticleModel base =
+      load_model(CLUMPKIT_SOURCE_DIR "/shapes/models/production.toml", CLUMPKIT_SOURCE_DIR);
+  ASSERT_EQ(base.types.front().name, "A");
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.size_distribution.A", "0.7", "test");
+  fake::FakeSimulator sim;
+  const auto ms = synthesize(sim, truth, 0.02, 31);
+  DiagnoseOptions o;
+  o.suggest = false;
+  const Diagnosis d = diagnose(base, ms, sim, o);
+  ASSERT_FALSE(d.consistent) << d.summary();
+  EXPECT_EQ(d.verdict, "size_distribution") << d.summary();
+  const CandidateResult& top = d.candidates.front();
+  EXPECT_NE(top.candidate.parameter.find("mass fraction of type A"), std::string::npos)
+      << d.summary();
+  EXPECT_LE(std::abs(top.fitted - 0.7), 2.0 * top.fitted_std + 1e-12)
+      << top.fitted << " +/- " << top.fitted_std;
+  EXPECT_GE(chi2_survival(top.comparison.chi2, top.comparison.dof), 0.01) << d.summary();
+  const ParticleModel next = top.candidate.apply(base, top.fitted);
+  EXPECT_NEAR(next.types[0].mass_fraction, top.fitted, 1e-12);
+  // B and C keep the model file's 35:30.
+  EXPECT_NEAR(next.types[1].mass_fraction / next.types[2].mass_fraction, 35.0 / 30.0, 1e-12);
+  fake::FakeSimulator sim2;
+  const Diagnosis d2 = diagnose(next, ms, sim2, o);
+  EXPECT_TRUE(d2.consistent) << d2.summary();
+}

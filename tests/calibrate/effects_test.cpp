@@ -160,5 +160,36 @@ TEST(EffectCandidates, ShapeResolutionOfAClumpTemplateIsTheOptimisersLadder) {
   fs::remove_all(dir);
 }
 
+TEST(EffectCandidates, AMixturesFractionIsItsFirstTypesShareWithTheOthersInTheirRatios) {
+  // The production model: A, B, C at 35/35/30 % by mass. Before session 44 only the height
+  // spread was a size_distribution candidate; the types' shares were fixed by the model file.
+  const ParticleModel prod = load_model(kModels / "production.toml");
+  std::vector<std::string> skipped;
+  const auto cs = effect_candidates(prod, {"size_distribution"}, &skipped);
+  ASSERT_EQ(cs.size(), 2u);  // the mass fraction, then the height spread
+  const EffectCandidate& f = cs[0];
+  EXPECT_NE(f.parameter.find("mass fraction of type A"), std::string::npos) << f.parameter;
+  EXPECT_EQ(f.baseline, 0.35);
+  EXPECT_FALSE(f.discrete);
+  EXPECT_GT(f.lo, 0.0);
+  EXPECT_LT(f.hi, 1.0);
+  EXPECT_NE(cs[1].parameter.find("height spread"), std::string::npos);
+  const ParticleModel half = f.apply(prod, 0.5);
+  EXPECT_EQ(half.types[0].mass_fraction, 0.5);
+  EXPECT_NEAR(half.types[1].mass_fraction, 0.5 * 35.0 / 65.0, 1e-15);
+  EXPECT_NEAR(half.types[2].mass_fraction, 0.5 * 30.0 / 65.0, 1e-15);
+  double sum = 0.0;
+  for (const auto& t : half.types) sum += t.mass_fraction;
+  EXPECT_NEAR(sum, 1.0, 1e-15);
+  EXPECT_NE(model_fingerprint(half), model_fingerprint(prod));
+  // The candidate's run at the baseline's share is the baseline model (the same cache key).
+  EXPECT_EQ(model_fingerprint(f.apply(prod, f.baseline)), model_fingerprint(prod));
+  // One type has no shares to fit: only the height spread is tried.
+  const auto one =
+      effect_candidates(load_model(kModels / "paper_A12.toml"), {"size_distribution"}, nullptr);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_NE(one[0].parameter.find("height spread"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace clumpkit::calibrate

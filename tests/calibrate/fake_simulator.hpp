@@ -30,6 +30,9 @@ class FakeSimulator final : public Simulator {
     const double e_pp = partner(e.restitution, "pill") > 0 ? partner(e.restitution, "pill") : 1.0;
     const double coh = e.cohesion.value_or(0.0);
     const double spread = e.size_distribution ? e.height_spread : 0.0;
+    // A mixture's first type (in a model of several) packs denser, heaps a little steeper and
+    // fills a pocket less than the others.
+    const double mix = model.types.size() > 1 ? model.types.front().mass_fraction - 0.5 : 0.0;
     const int spheres = e.shape_resolution.value_or(model.types.front().paper_spheres.value_or(12));
     const std::string wall = r.settings.count("wall")    ? r.settings.at("wall")
                              : r.settings.count("plate") ? r.settings.at("plate")
@@ -40,18 +43,19 @@ class FakeSimulator final : public Simulator {
       // Rolling friction changes the packing little; cohesion opens it up (CALIBRATION.md); a
       // spread of pill heights packs a little denser.
       mean["bulk_density"] = 760 - 120 * std::tanh(mus) - 10 * mur - 4e-3 * coh - 40 * muw +
-                             15 * (e_pp - 0.5) + 2.0 * (spheres - 12) + 150 * spread;
+                             15 * (e_pp - 0.5) + 2.0 * (spheres - 12) + 150 * spread + 60 * mix;
     } else if (r.rig == "angle_of_repose") {
       // A free heap: wall (plate) friction matters little, cohesion and rolling friction a lot.
       const double a = 14 + 25 * std::tanh(2 * mur) + 8 * mus + 1.2e-3 * coh +
-                       1.5 * std::tanh(muw) - 0.3 * (20 - spheres) + 2 * (0.5 - e_pp) - 10 * spread;
+                       1.5 * std::tanh(muw) - 0.3 * (20 - spheres) + 2 * (0.5 - e_pp) -
+                       10 * spread + 3 * mix;
       mean["angle"] = a;
       mean["angle_left"] = a + 0.2;
       mean["angle_right"] = a - 0.2;
     } else {
       const double rpm = std::stod(r.settings.at("rpm"));
-      mean["pocket_mass"] =
-          0.25 - 0.0008 * (rpm - 10) - 0.02 * muw - 0.01 * mur - 4e-7 * coh + 0.05 * spread;
+      mean["pocket_mass"] = 0.25 - 0.0008 * (rpm - 10) - 0.02 * muw - 0.01 * mur - 4e-7 * coh +
+                            0.05 * spread - 0.03 * mix;
       mean["pocket_mass_cv"] = 0.03 + 0.0004 * std::abs(rpm - 15) + 0.01 * mur;
       mean["mass_flow"] = mean["pocket_mass"] * 8 * rpm / 60;
     }

@@ -8,7 +8,9 @@
 // Numerical faults (a simulation that blows up) are the exception: a run legitimately writes its
 // series and frames up to the fault, so a case may list `outputs` folders where new files are
 // allowed; every text file in them must then be free of NaN and infinity, and `allow_warnings`
-// lets the run's own warning lines ("...warning: ...") precede the one-line diagnosis.
+// lets the run's own warning lines ("...warning: ...") precede the one-line diagnosis. Input found
+// bad only once a run has started (a mesh that fails to load while the clumps are built) may
+// follow the run's progress lines: `allow_progress` lets lines without "error" precede it.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -57,6 +59,7 @@ struct Case {
   std::vector<std::string> absent;
   std::vector<std::string> outputs;  // folders where a failing run may leave (NaN-free) files
   bool allow_warnings = false;       // lines before the diagnosis must be warnings
+  bool allow_progress = false;       // lines before the diagnosis may be progress (no "error")
   std::string load_error;            // a malformed catalogue entry becomes one failing case
 };
 
@@ -120,6 +123,7 @@ std::vector<Case> load_catalogue() {
         c.absent = doc.strings(p + "absent");
         c.outputs = doc.strings(p + "outputs");
         c.allow_warnings = doc.boolean_opt(p + "allow_warnings").value_or(false);
+        c.allow_progress = doc.boolean_opt(p + "allow_progress").value_or(false);
         cases.push_back(std::move(c));
       }
     } catch (const clumpkit::InputError& e) {
@@ -241,12 +245,17 @@ TEST_P(BadInput, FailsCleanly) {
   ASSERT_FALSE(out.err.empty()) << "no message on stderr";
   EXPECT_EQ(out.err.back(), '\n') << "message not terminated: " << out.err;
   std::string line = out.err.substr(0, out.err.size() - 1);
-  if (c.allow_warnings) {  // "<prefix>warning: ..." lines, then the diagnosis
+  if (c.allow_warnings || c.allow_progress) {  // warning or progress lines, then the diagnosis
     const size_t last = line.rfind('\n');
     if (last != std::string::npos) {
-      std::istringstream warnings(line.substr(0, last));
-      for (std::string w; std::getline(warnings, w);)
-        EXPECT_NE(w.find("warning: "), std::string::npos) << "not a warning line: " << w;
+      std::istringstream before_it(line.substr(0, last));
+      for (std::string w; std::getline(before_it, w);) {
+        if (c.allow_warnings && !c.allow_progress) {
+          EXPECT_NE(w.find("warning: "), std::string::npos) << "not a warning line: " << w;
+        } else if (!c.allow_warnings) {
+          EXPECT_EQ(w.find("error"), std::string::npos) << "an error before the diagnosis: " << w;
+        }
+      }
       line = line.substr(last + 1);
     }
   }

@@ -55,3 +55,35 @@ TEST(AtomicFile, FullDiskLeavesOldContentAndNoTemporary) {
   EXPECT_EQ(entries(d), 1u);
   fs::remove_all(d);
 }
+
+TEST(OutputFolder, TheFoldersItMadeGoAgainWhenLeftEmpty) {
+  const fs::path d = fresh_dir("outfolder");
+  {
+    OutputFolder out(d / "runs" / "first", "--out");  // two levels made
+    EXPECT_TRUE(fs::is_directory(d / "runs" / "first"));
+  }
+  EXPECT_FALSE(fs::exists(d / "runs"));  // both taken away, the one that was there kept
+  EXPECT_TRUE(fs::is_directory(d));
+  {
+    OutputFolder out(d / "kept", "--out");
+    write_file_atomic(d / "kept" / "result.json", "{}");
+  }
+  EXPECT_TRUE(fs::exists(d / "kept" / "result.json"));  // written into: kept
+  fs::create_directories(d / "before");
+  { OutputFolder out(d / "before", "--out"); }
+  EXPECT_TRUE(fs::is_directory(d / "before"));  // there before the command: kept, even empty
+  write_file_atomic(d / "file", "x");
+  try {
+    OutputFolder out(d / "file", "--report");
+    ADD_FAILURE() << "a file taken for a folder";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a folder"), std::string::npos) << e.what();
+  }
+  try {
+    OutputFolder out(d / "file" / "sub", "--out");
+    ADD_FAILURE() << "a folder under a file";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  fs::remove_all(d);
+}

@@ -289,6 +289,35 @@ size_distribution = { height_spread = 0.1 }
   EXPECT_NE(e.find("clump template"), std::string::npos) << e;
 }
 
+TEST(Model, ATypesMassFractionIsSetFromTheCommandLineTheOthersKeepTheirRatios) {
+  ParticleModel m = load_model(kModels / "production.toml");  // A, B, C at 35/35/30 %
+  set_model_effect(m, "effects.size_distribution.C", "0.6", "--set");
+  EXPECT_EQ(m.types[2].mass_fraction, 0.6);
+  EXPECT_NEAR(m.types[0].mass_fraction, 0.2, 1e-15);  // 0.35 * 0.4 / 0.7
+  EXPECT_NEAR(m.types[1].mass_fraction, 0.2, 1e-15);
+  EXPECT_TRUE(m.effects.size_distribution);
+  // The population (the factory's mixture) follows.
+  double c_share = 0.0;
+  for (const auto& t : m.population())
+    if (t.name == "C") c_share += t.mass_fraction;
+  EXPECT_NEAR(c_share, 0.6, 1e-15);
+  auto set_error = [&](const std::string& key, const std::string& value) {
+    return error_from([&] { set_model_effect(m, key, value, "--set"); });
+  };
+  std::string e = set_error("effects.size_distribution.D", "0.5");
+  EXPECT_NE(e.find("--set"), std::string::npos) << e;
+  EXPECT_NE(e.find("A, B, C"), std::string::npos) << e;
+  for (const char* bad : {"1", "0", "1.5", "-0.2", "half"}) {
+    e = set_error("effects.size_distribution.A", bad);
+    EXPECT_NE(e.find("effects.size_distribution.A"), std::string::npos) << bad << ": " << e;
+  }
+  EXPECT_NEAR(m.types[2].mass_fraction, 0.6, 1e-15);  // a refused value changes nothing
+  // One type has no shares to set.
+  ParticleModel one = parse(kHead);
+  e = error_from([&] { set_model_effect(one, "effects.size_distribution.A", "0.5", "--set"); });
+  EXPECT_NE(e.find("several types"), std::string::npos) << e;
+}
+
 TEST(Model, ErrorsNameFileLineAndKey) {
   std::string e = error_of(std::string(kHead) + "[effects]\nstickiness = true\n");
   EXPECT_NE(e.find("test_model.toml"), std::string::npos) << e;

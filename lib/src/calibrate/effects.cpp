@@ -176,7 +176,15 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       first = false;
     }
     common.erase(current);
-    if (common.empty()) {
+    std::string blocked;
+    if (!common.empty()) try {
+        with(base, "effects.shape_resolution", fmt::format("{}", *common.begin()));
+      } catch (const InputError& e) {
+        blocked = e.message();
+      }
+    if (!blocked.empty()) {
+      skip("shape_resolution", blocked);
+    } else if (common.empty()) {
       skip("shape_resolution",
            "no other sphere count fits every type (paper-rule types: their "
            "rule's presets; clump templates: 2, 4, 8, 16, 32 by the optimiser)");
@@ -225,9 +233,26 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       out.push_back(c);
     }
   }
+  if (wanted("size_distribution") && base.types.size() > 1) {
+    // A mixture's fractions: the first type's mass fraction, the others sharing the rest in the
+    // baseline's ratios (a model of several types holds the effect on: its baseline is the
+    // model file's fraction). The range keeps every type in the population.
+    const ModelType& t = base.types.front();
+    EffectCandidate c;
+    c.effect = "size_distribution";
+    c.parameter = "mass fraction of type " + t.name + " (the other types keep their ratios)";
+    c.unit = "1";
+    c.lo = std::min(0.02, t.mass_fraction);
+    c.hi = std::max(0.98, t.mass_fraction);
+    c.baseline = t.mass_fraction;
+    c.probe = probe_from(c.baseline, 0.2, c.lo, c.hi);
+    c.apply = [key = "effects.size_distribution." + t.name](const ParticleModel& m, double v) {
+      return with(m, key, fmt::format("{:.17g}", v));
+    };
+    out.push_back(c);
+  }
   if (wanted("size_distribution")) {
-    // The mixture's fractions are fixed by the model file (several types need it on); what can
-    // be missing is the spread of pill heights within each type.
+    // The spread of pill heights within each type.
     try {
       with(base, "effects.size_distribution", "0.1");
       continuous("size_distribution", "height spread (mass-weighted relative std)", "1", 0.0, 0.2,

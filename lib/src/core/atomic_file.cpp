@@ -78,4 +78,36 @@ void check_writable(const fs::path& path, const std::string& field) {
   if (fs::is_directory(path, ec)) throw InputError(path.string(), field, "is a directory");
 }
 
+OutputFolder::OutputFolder(const fs::path& dir, const std::string& field) : dir_(dir) {
+  std::error_code ec;
+  // The topmost missing folder on the way down to `dir` is the one to take away again.
+  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    made_ = p;
+    if (p == p.parent_path()) break;
+  }
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw InputError(dir.string(), field, "exists and is not a folder");
+  fs::create_directories(dir, ec);  // a failure is named by the check below
+  try {
+    check_writable(dir / "x.json", field);  // "folder '...' does not exist" / "is not writable"
+  } catch (...) {
+    remove_if_empty();
+    throw;
+  }
+}
+
+OutputFolder::~OutputFolder() {
+  remove_if_empty();
+}
+
+void OutputFolder::remove_if_empty() noexcept {
+  if (made_.empty()) return;
+  std::error_code ec;
+  for (fs::path p = dir_;; p = p.parent_path()) {
+    if (!fs::is_directory(p, ec) || !fs::is_empty(p, ec) || ec) return;
+    fs::remove(p, ec);
+    if (ec || p == made_ || p == p.parent_path()) return;
+  }
+}
+
 }  // namespace clumpkit

@@ -99,6 +99,17 @@ std::string height_spread_blocker(const ParticleModel& m) {
   return "";
 }
 
+// Why shape_resolution cannot fill this model's clump-template types again (a mesh shape whose
+// file is not there); "" when it can. Checked where the effect is set, so a run is refused before
+// it starts and a diagnosis skips the candidate with the reason.
+std::string shape_resolution_blocker(const ParticleModel& m) {
+  for (const ModelType& t : m.types)
+    if (!t.paper_spheres && t.shape.kind == ShapeSpec::Kind::Mesh && !path_exists(t.shape.mesh))
+      return "type " + t.name + " is filled again from its shape's mesh '" + t.shape.mesh.string() +
+             "' (shape file " + t.shape_path.string() + "), which is not there";
+  return "";
+}
+
 // Effect tables are either `name = true` / `name = false` or a table `[effects.name]`.
 bool effect_listed(const TomlDoc& doc, const std::string& e, bool& as_table) {
   const std::string key = "effects." + e;
@@ -287,6 +298,8 @@ ParticleModel parse_model(const std::string& text, const fs::path& path, const f
     const long long n = doc.integer("effects.shape_resolution.spheres");
     doc.require_range("effects.shape_resolution.spheres", double(n), 1, 1000);
     fx.shape_resolution = int(n);
+    if (const std::string why = shape_resolution_blocker(m); !why.empty())
+      doc.fail("effects.shape_resolution", why);
   }
   fx.size_distribution = effect_listed(doc, "size_distribution", tbl);
   if (m.types.size() > 1 && !fx.size_distribution)
@@ -574,12 +587,40 @@ void set_model_effect(ParticleModel& m, const std::string& key, const std::strin
   } else if (name == "cohesion") {
     fx.cohesion = parse_quantity(value, Dimension::Pressure, where, key);
   } else if (name == "shape_resolution") {
-    fx.shape_resolution = int(parse_number(value, where, key, 1, 1000));
+    const int n = int(parse_number(value, where, key, 1, 1000));
+    if (const std::string why = shape_resolution_blocker(m); !why.empty())
+      throw InputError(where, key, why);
+    fx.shape_resolution = n;
   } else if (name == "size_distribution") {
     // "on", or a number: the height spread (effects.size_distribution=0.05 or
-    // effects.size_distribution.height_spread=0.05).
-    if (!partner.empty() && partner != "height_spread")
-      throw InputError(where, key, "size_distribution has one parameter: height_spread");
+    // effects.size_distribution.height_spread=0.05); effects.size_distribution.TYPE=0.5: that
+    // type's mass fraction, the other types sharing the rest in their ratios.
+    if (!partner.empty() && partner != "height_spread") {
+      auto it = std::find_if(m.types.begin(), m.types.end(),
+                             [&](const ModelType& t) { return t.name == partner; });
+      if (it == m.types.end() || m.types.size() < 2) {
+        std::string names;
+        for (const auto& t : m.types) names += (names.empty() ? "" : ", ") + t.name;
+        throw InputError(where, key,
+                         m.types.size() < 2
+                             ? "size_distribution's parameters: height_spread, or a type's mass "
+                               "fraction in a model of several types (this one has one: " +
+                                   names + ")"
+                             : "size_distribution's parameters: height_spread, or the mass "
+                               "fraction of a type (" +
+                                   names + ")");
+      }
+      const double x = parse_number(value, where, key, 0.0, 1.0);
+      if (x <= 0.0 || x >= 1.0)
+        throw InputError(where, key,
+                         "a type's mass fraction is between 0 and 1 (exclusive: every type of "
+                         "the model keeps some mass)");
+      const double others = 1.0 - it->mass_fraction;  // > 0: every type holds some mass
+      for (auto& t : m.types)
+        t.mass_fraction = &t == &*it ? x : t.mass_fraction * (1.0 - x) / others;
+      fx.size_distribution = true;
+      return;
+    }
     double spread = fx.size_distribution ? fx.height_spread : 0.0;
     if (value != "on") spread = parse_number(value, where, key, 0.0, kMaxHeightSpread);
     if (spread > 0)

@@ -23,4 +23,24 @@ bool path_exists(const std::filesystem::path& path) noexcept;
 /// fail before doing expensive work. Throws InputError naming the path and `field`.
 void check_writable(const std::filesystem::path& path, const std::string& field = "");
 
+/// An output folder a command makes before its work, so that a folder it cannot write is refused
+/// before any long run. The folders it had to create are removed again when it goes out of scope
+/// still empty: a command that fails before writing its first file (a missing mesh found while
+/// the clumps are built, say) leaves nothing behind. A folder that existed before is never
+/// removed, nor one that holds anything.
+class OutputFolder {
+ public:
+  /// Creates `dir` (and missing parents); throws InputError naming `field` if it cannot be
+  /// created or written.
+  OutputFolder(const std::filesystem::path& dir, const std::string& field);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+
+ private:
+  void remove_if_empty() noexcept;
+  std::filesystem::path dir_;
+  std::filesystem::path made_;  ///< the topmost folder this one created; empty: none
+};
+
 }  // namespace clumpkit

@@ -111,7 +111,9 @@ ParticleModel parse_model(const std::string& text, const std::filesystem::path& 
 std::string model_fingerprint(const ParticleModel& model);
 
 /// Replaces an effect from a `--set`-style assignment "effects.rolling_friction.pill=0.1" or
-/// "effects.cohesion=off". Throws InputError naming `where` for unknown effects or bad values.
+/// "effects.cohesion=off". "effects.size_distribution.TYPE=0.5" sets a type's mass fraction in a
+/// model of several types (the others share the rest in their ratios). Throws InputError naming
+/// `where` for unknown effects or bad values.
 void set_model_effect(ParticleModel& model, const std::string& key, const std::string& value,
                       const std::string& where);
 
