@@ -86,7 +86,8 @@ Command setup_rig(CLI::App& parent) {
   c->add_option("--set", a->sets,
                 "key=value: a rig setting (see --list; e.g. rpm=30, plate=abs_plastic, "
                 "lift_speed=200) or a model effect (effects.rolling_friction.pill=0.1, "
-                "effects.cohesion=\"2e4 J/m^3\", effects.restitution=off)");
+                "effects.cohesion=\"2e4 J/m^3\", effects.restitution=off, "
+                "effects.size_distribution.B=0.5: type B's mass fraction)");
   c->add_option("--json", a->json, "Write the result as JSON (FILE or -)");
   c->add_option("--out", a->out,
                 "Folder for checkpoints, per-repeat results and pictures (a rerun resumes and "
