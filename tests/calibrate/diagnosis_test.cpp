@@ -169,6 +169,9 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
   // A stated sigma that is too small shows here first (issue 7: the fitted strength within its
   // stated uncertainty of the truth).
   EXPECT_GE(covered1, 22) << covered1 << " of " << trials << " within 1 stated sigma";
+  // Nor inflated out of use: the surrogate's redraws (session 44) widen sigma where the curve is
+  // uncertain, not everywhere (31 of 40 within 1 sigma with them, 26 without; nominal 27).
+  EXPECT_LE(covered1, 36) << covered1 << " of " << trials << " within 1 stated sigma";
 }
 
 TEST(Diagnosis, NoFalseVerdictWhenNothingIsMissing) {

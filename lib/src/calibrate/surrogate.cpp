@@ -44,6 +44,20 @@ double Surrogate::value(const std::string& key, double theta) const {
   return at(theta);
 }
 
+Surrogate Surrogate::redrawn(std::mt19937_64& rng) const {
+  Surrogate r = *this;
+  r.coef.clear();
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (auto& [t, v] : r.points)
+    for (auto& [key, x] : v) {
+      const auto rv = run_var.find(key);
+      const double var = rv != run_var.end() ? rv->second : x.n >= 2 ? x.std * x.std : 0.0;
+      const double draw = g(rng);  // drawn for every value: the stream does not depend on var
+      if (var > 0.0) x.mean += draw * std::sqrt(var / std::max(1, x.n));
+    }
+  return r;
+}
+
 double Surrogate::noise_var(const std::string& key, double run_var, int base_n) const {
   const double floor = base_n > 0 ? run_var / base_n : run_var;
   double sum = 0.0;
@@ -198,8 +212,8 @@ double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& va
 }
 
 Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
-                  double lo, double hi) {
-  const int n = 2000;
+                  double lo, double hi, int redraws) {
+  const int n = redraws > 0 ? 2000 : 400;
   std::vector<double> th(n + 1), c(n + 1);
   Fit f;
   f.chi2 = std::numeric_limits<double>::infinity();
@@ -223,6 +237,29 @@ Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const 
   while (b < n && c[b] < f.chi2 + 4.0) ++b;
   f.lo95 = th[a];
   f.hi95 = th[b];
+  if (redraws < 2 || s.points.size() < 2) return f;
+  // The surrogate's own noise: the fit on redrawn surrogates (a coarser grid), its spread added
+  // to sigma in quadrature.
+  std::mt19937_64 rng(0x5eed5eedULL + s.points.size());
+  double sum = 0.0, sum2 = 0.0;
+  for (int r = 0; r < redraws; ++r) {
+    const Fit fr = fit_surrogate(ms, base, s.redrawn(rng), lo, hi, 0);
+    sum += fr.theta;
+    sum2 += fr.theta * fr.theta;
+  }
+  const double mean = sum / redraws;
+  const double spread =
+      std::sqrt(std::max(0.0, sum2 / redraws - mean * mean) * redraws / (redraws - 1.0));
+  const double sigma = std::hypot(f.sigma, spread);
+  if (f.sigma > 0.0) {
+    const double k = sigma / f.sigma;
+    f.lo95 = std::max(lo, f.theta - k * (f.theta - f.lo95));
+    f.hi95 = std::min(hi, f.theta + k * (f.hi95 - f.theta));
+  } else {
+    f.lo95 = std::max(lo, f.theta - 2.0 * sigma);
+    f.hi95 = std::min(hi, f.theta + 2.0 * sigma);
+  }
+  f.sigma = sigma;
   return f;
 }
 
