@@ -751,13 +751,8 @@ double Diagnoser::rank() {
       d.verdict = top.candidate.effect;
       d.confidence = top.weight;
       for (size_t i = 1; i < d.candidates.size(); ++i)
-        if (d.candidates[i].bic - top.bic < 2.0) {
-          // Two forms of one effect (size_distribution's mixture shares and height spread) are
-          // told apart by their parameter.
-          const EffectCandidate& c = d.candidates[i].candidate;
-          d.indistinguishable.push_back(
-              c.effect == top.candidate.effect ? c.effect + " (" + c.parameter + ")" : c.effect);
-        }
+        if (d.candidates[i].bic - top.bic < 2.0)
+          d.indistinguishable.push_back(name_beside(d.candidates[i].candidate, top.candidate));
       // Observables whose misfit the winner removes most.
       std::vector<std::pair<double, std::string>> gain;
       for (size_t i = 0; i < ms.size(); ++i) {

@@ -20,6 +20,10 @@ std::string EffectCandidate::format(double v) const {
   return unit == "1" ? fmt::format("{:.4g}", v) : fmt::format("{:.4g} {}", v, unit);
 }
 
+std::string name_beside(const EffectCandidate& c, const EffectCandidate& other) {
+  return c.effect == other.effect ? c.effect + " (" + c.parameter + ")" : c.effect;
+}
+
 namespace {
 
 // The variant's name tells the progress lines which run is which: "base [rolling_friction=0.16]".
@@ -176,12 +180,13 @@ std::vector<EffectCandidate> effect_candidates(const ParticleModel& base,
       first = false;
     }
     common.erase(current);
-    std::string blocked;
-    if (!common.empty()) try {
+    std::string blocked;  // a template's mesh to fill again is gone: set_model_effect says so
+    try {
+      if (!common.empty())
         with(base, "effects.shape_resolution", fmt::format("{}", *common.begin()));
-      } catch (const InputError& e) {
-        blocked = e.message();
-      }
+    } catch (const InputError& e) {
+      blocked = e.message();
+    }
     if (!blocked.empty()) {
       skip("shape_resolution", blocked);
     } else if (common.empty()) {

@@ -121,11 +121,8 @@ void suggest_measurement(const ParticleModel& base, const std::vector<Measuremen
         s.setting = format_settings(settings);
         s.quantity = q;
         s.separation = std::abs(x.mean - y) / sigma;
-        // Two forms of one effect (a mixture's shares, a height spread) by their parameters.
-        s.between = a.candidate.effect == b.candidate.effect
-                        ? a.candidate.effect + " (" + a.candidate.parameter + " vs " +
-                              b.candidate.parameter + ")"
-                        : a.candidate.effect + " vs " + b.candidate.effect;
+        s.between =
+            name_beside(a.candidate, b.candidate) + " vs " + name_beside(b.candidate, a.candidate);
         d.suggestions.push_back(s);
       }
     }

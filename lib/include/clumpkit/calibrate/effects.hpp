@@ -30,6 +30,11 @@ struct EffectCandidate {
   std::string format(double value) const;  ///< "0.083" / "rolling_model=cdt" / "12 spheres"
 };
 
+/// How `c` is named beside `other` (in a list of indistinguishable effects, a suggestion "a vs
+/// b"): its effect id, with its parameter where both are forms of one effect
+/// (size_distribution's mixture shares and height spread).
+std::string name_beside(const EffectCandidate& c, const EffectCandidate& other);
+
 /// Candidates for a baseline model. `only` (effect ids) restricts the list; unknown ids throw
 /// InputError naming `where`. Effects that cannot be tried on this model (a height spread of
 /// size_distribution on a type that is not a paper-rule cylinder; rolling_model without rolling
