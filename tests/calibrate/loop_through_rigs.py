@@ -132,6 +132,8 @@ def main():
     ap.add_argument("--work", required=True, help="scratch folder (emptied first)")
     ap.add_argument("--case", choices=sorted(CASES), default="rolling_friction")
     ap.add_argument("--jobs", default="0", help="rig runs side by side (0 = one per core)")
+    ap.add_argument("--all-effects", action="store_true",
+                    help="diagnose over the whole effect catalogue, not the case's candidates")
     ap.add_argument("--keep-cache", action="store_true",
                     help="keep WORK/cache from an earlier run (same engine only)")
     a = ap.parse_args()
@@ -187,8 +189,9 @@ def main():
     run("synth", "--model", "truth.toml", "--measurements-template", "template.csv",
         "--noise", "0.03", "--seed", "7", "--repeats", str(case.get("truth_repeats", 2)),
         "-o", "lab.csv", *common)
-    diagnose = ["diagnose", "--model", "base.toml", "--measurements", "lab.csv", "--effects",
-                case["effects"], "--no-suggest"]
+    narrowed = [] if a.all_effects else ["--effects", case["effects"]]
+    diagnose = ["diagnose", "--model", "base.toml", "--measurements", "lab.csv", *narrowed,
+                "--no-suggest"]
     run(*diagnose, "--apply", "-o", "v2.toml", "--json", "diag.json", *common)
     again = run(*diagnose, "--json", "diag2.json", *common)
     hidden = case["hidden"]
