@@ -17,6 +17,11 @@ class FakeSimulator final : public Simulator {
   // false: every model draws its own noise, as a chaotic granular flow does when a parameter
   // changes a little (the rigs' runs decorrelate quickly).
   bool common_random_numbers = true;
+  // Relative std of a scatter that every repeat of one model shares (0: none): a variant's
+  // repeats then agree more closely than its mean agrees with a smooth response, so their
+  // spread understates how far the mean of a nearby variant can be.
+  double variant_noise_rel = 0.0;
+  std::uint64_t variant_seed = 0;  // which shared scatter each model gets
 
   SimValues simulate(const ParticleModel& model, const SimRequest& r, int repeats,
                      std::uint64_t seed) override {
@@ -65,8 +70,15 @@ class FakeSimulator final : public Simulator {
       std::seed_seq ss{seed, std::hash<std::string>{}(r.key() + q + salt)};
       std::mt19937_64 rng(ss);
       std::normal_distribution<double> g(0.0, noise_rel * std::abs(m));
+      double shared = 0.0;
+      if (variant_noise_rel > 0.0) {
+        std::seed_seq vs{variant_seed,
+                         std::hash<std::string>{}(r.key() + q + model_fingerprint(model))};
+        std::mt19937_64 vr(vs);
+        shared = std::normal_distribution<double>(0.0, variant_noise_rel * std::abs(m))(vr);
+      }
       std::vector<double> v;
-      for (int k = 0; k < repeats; ++k) v.push_back(m + g(rng));
+      for (int k = 0; k < repeats; ++k) v.push_back(m + shared + g(rng));
       out[q] = summarize(v);
     }
     return out;

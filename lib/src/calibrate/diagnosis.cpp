@@ -181,7 +181,7 @@ class Diagnoser {
   Fit refit(Work& w) const {
     const auto [lo, hi] = fit_range(w);
     const Values pooled = pool.pooled(s0);
-    w.s.aim(w.fit.theta, pooled);
+    w.s.aim(w.fit.theta, pooled, &pool);
     return fit_surrogate(ms, pooled, w.s, lo, hi);
   }
   // The probe of a continuous candidate that has only its screen (baseline and probe), or NaN.

@@ -13,20 +13,58 @@ void Surrogate::add(double theta, Values v) {
     if (p.first == theta) {
       p.second = std::move(v);
       coef.clear();
+      scatter.clear();
       return;
     }
   points.emplace_back(theta, std::move(v));
   std::sort(points.begin(), points.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   coef.clear();
+  scatter.clear();
 }
 
-void Surrogate::aim(double theta, const Values& pooled) {
+void Surrogate::aim(double theta, const Values& pooled, const SpreadPool* pool) {
   focus = theta;
   run_var.clear();
-  for (const auto& [k, v] : pooled)
+  family.clear();
+  for (const auto& [k, v] : pooled) {
     if (v.n >= 2 && std::isfinite(v.std) && v.std > 0) run_var[k] = v.std * v.std;
+    family[k] = pool ? pool->family(k) : k;
+  }
   coef.clear();
+  scatter.clear();
+}
+
+double Surrogate::scatter_var(const std::string& key) const {
+  const auto rv = run_var.find(key);
+  if (rv == run_var.end()) return 0.0;
+  const auto fk = family.find(key);
+  const std::string& fam = fk == family.end() ? key : fk->second;
+  auto known = scatter.find(fam);
+  if (known == scatter.end()) {
+    double sum = 0.0;  // pseudo-residuals squared, each in units of its observable's run variance
+    int k = 0;
+    const double span = points.empty() ? 0.0 : points.back().first - points.front().first;
+    for (const auto& [other, var] : run_var) {
+      const auto fo = family.find(other);
+      if ((fo == family.end() ? other : fo->second) != fam) continue;
+      for (size_t i = 1; i + 1 < points.size(); ++i) {
+        const double t0 = points[i - 1].first, t1 = points[i].first, t2 = points[i + 1].first;
+        if (t2 - t0 > kNeighbourSpan * span) continue;
+        const SimulatedValue& y0 = points[i - 1].second.at(other);
+        const SimulatedValue& y1 = points[i].second.at(other);
+        const SimulatedValue& y2 = points[i + 1].second.at(other);
+        const double b = (t1 - t0) / (t2 - t0), a = 1.0 - b;
+        const double e = a * y0.mean + b * y2.mean - y1.mean;
+        sum += e * e / var /
+               (a * a / std::max(1, y0.n) + b * b / std::max(1, y2.n) + 1.0 / std::max(1, y1.n));
+        ++k;
+      }
+    }
+    const double factor = k > 0 && chi2_survival(sum, k) < kExcessScatter ? sum / k : 1.0;
+    known = scatter.emplace(fam, factor).first;
+  }
+  return known->second * rv->second;
 }
 
 double Surrogate::value(const std::string& key, double theta) const {
@@ -45,13 +83,14 @@ double Surrogate::value(const std::string& key, double theta) const {
 }
 
 Surrogate Surrogate::redrawn(std::mt19937_64& rng) const {
-  Surrogate r = *this;
+  for (const auto& [key, x] : points.front().second) scatter_var(key);
+  Surrogate r = *this;  // with this surrogate's scatter_var
   r.coef.clear();
   std::normal_distribution<double> g(0.0, 1.0);
   for (auto& [t, v] : r.points)
     for (auto& [key, x] : v) {
-      const auto rv = run_var.find(key);
-      const double var = rv != run_var.end() ? rv->second : x.n >= 2 ? x.std * x.std : 0.0;
+      const double aimed = scatter_var(key);
+      const double var = aimed > 0.0 ? aimed : x.n >= 2 ? x.std * x.std : 0.0;
       const double draw = g(rng);  // drawn for every value: the stream does not depend on var
       if (var > 0.0) x.mean += draw * std::sqrt(var / std::max(1, x.n));
     }
@@ -59,6 +98,7 @@ Surrogate Surrogate::redrawn(std::mt19937_64& rng) const {
 }
 
 double Surrogate::noise_var(const std::string& key, double run_var, int base_n) const {
+  run_var = std::max(run_var, scatter_var(key));
   const double floor = base_n > 0 ? run_var / base_n : run_var;
   double sum = 0.0;
   int k = 0;
@@ -166,8 +206,7 @@ const Surrogate::Poly& Surrogate::poly(const std::string& key) const {
   if (it != coef.end()) return it->second;
   std::vector<Pt> pts;
   for (const auto& [t, v] : points) pts.push_back({t, v.at(key).mean, v.at(key).n});
-  const auto rv = run_var.find(key);
-  const double var = rv == run_var.end() ? 0.0 : rv->second;
+  const double var = scatter_var(key);
   Poly p = fit(pts, var);
   if (std::isfinite(focus) && var > 0.0) {
     // Nearest the focus first; drop from the far end while the fit misses its points.

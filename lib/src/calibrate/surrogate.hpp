@@ -38,20 +38,38 @@ class Surrogate {
   /// Adds (or replaces) the point at `theta`.
   void add(double theta, Values v);
   /// Where the next fit is made, and the pooled seed-to-seed spread of one run per observable
-  /// (the noise the lack-of-fit test weighs the points' misses by).
-  void aim(double theta, const Values& pooled);
+  /// (the noise the lack-of-fit test weighs the points' misses by), pooled in the families of
+  /// `pool` (none: each observable its own).
+  void aim(double theta, const Values& pooled, const SpreadPool* pool = nullptr);
   /// The surrogate's mean of observable `key` at `theta`.
   double value(const std::string& key, double theta) const;
-  /// A copy whose points' means are redrawn within their seed noise (one run's variance: the
-  /// pooled one the surrogate was aimed with, else the point's own spread; std^2 / n for a mean
-  /// of n repeats). Fitted again, it shows how far the fit moves with the surrogate's own noise.
+  /// A copy whose points' means are redrawn within their seed noise (one run's variance:
+  /// scatter_var, else, where the surrogate was not aimed, the point's own spread; std^2 / n
+  /// for a mean of n repeats). Fitted again, it shows how far the fit moves with the surrogate's
+  /// own noise.
   Surrogate redrawn(std::mt19937_64& rng) const;
   /// Variance of a simulated mean through the surrogate, averaged over its points: each point's
   /// own seed scatter (std^2/n) where it has repeats, the pooled per-run variance `run_var` for
   /// a single-run (screening) point; never below the baseline's `run_var / base_n`. Heaps with
   /// more rolling friction scatter more than the baseline's (tiny scale: 2-4 deg against 1.6),
-  /// so the baseline's scatter alone understated the fitted uncertainty.
+  /// so the baseline's scatter alone understated the fitted uncertainty. Where the points
+  /// scatter about a smooth curve by more than `run_var` (scatter_var), by that scatter.
   double noise_var(const std::string& key, double run_var, int base_n) const;
+  /// One run's variance of observable `key` as the surrogate weighs its points: the pooled one
+  /// it was aimed with, or, where neighbouring points scatter about a smooth curve by
+  /// significantly more (a chi2 test at 5 %), that scatter (as a multiple of the pooled
+  /// variance, the same for the observables of one pooling family). The scatter is measured
+  /// from pseudo-residuals (each point against the straight line through its two neighbours, a
+  /// difference-based estimate that a linear trend does not bias) of the points close together,
+  /// as refinement runs are (three in a row within a quarter of all the points' span, where
+  /// curvature adds little), over the family's observables. The pooled spread need not be all
+  /// of a mean's scatter: it is pooled over settings that scatter differently, each from a few
+  /// two-repeat spreads. Session 45's mixture (tiny scale, pill A with tablet D) pooled 1.8 deg
+  /// over three plates (0.97 deg on galvanized steel, 2.1 on ABS, 2.3 on organic glass) where
+  /// six more seeds on ABS gave 3.1; four refinement means on ABS within 0.035 of A's share
+  /// then spread over 8 deg, and, taken as signal, gave a local slope of 270 deg per unit and a
+  /// stated uncertainty of the fit 7 times too small. 0 if the surrogate was not aimed.
+  double scatter_var(const std::string& key) const;
 
  private:
   struct Poly {
@@ -63,9 +81,19 @@ class Surrogate {
     double t, y;
     int n;
   };
+  /// Points closer together than this share of all the points' span count as neighbours for
+  /// scatter_var.
+  static constexpr double kNeighbourSpan = 0.25;
+  /// The points' scatter replaces the pooled run variance where so large a scatter has a
+  /// probability below this with the pooled one (chi2 test).
+  static constexpr double kExcessScatter = 0.05;
   mutable std::map<std::string, Poly> coef;
+  /// scatter_var's factor on the pooled variance per family, computed once per set of points
+  /// (a redrawn copy keeps the original's: the redraw's own noise must not be counted twice).
+  mutable std::map<std::string, double> scatter;
   double focus = std::numeric_limits<double>::quiet_NaN();
   std::map<std::string, double> run_var;
+  std::map<std::string, std::string> family;  ///< observable key -> its pooling family
 
   /// Lack of fit of `p` at the points, in units of their seed noise (`var`: one run's
   /// variance), as the probability of a miss this large from noise alone.

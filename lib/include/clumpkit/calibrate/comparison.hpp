@@ -62,9 +62,10 @@ class SpreadPool {
   std::map<std::string, SimulatedValue> pooled(std::map<std::string, SimulatedValue> values) const;
   /// Degrees of freedom behind the pooled spread of observable `key` (0: unknown).
   int dof(const std::string& key) const;
+  /// The pooling family of observable `key` (rig|sample|quantity; the key itself if unknown).
+  const std::string& family(const std::string& key) const;
 
  private:
-  const std::string& family(const std::string& key) const;
   std::map<std::string, std::string> family_;          ///< observable key -> pooling family
   std::map<std::string, std::pair<double, int>> acc_;  ///< per family: sum (n-1) s^2, sum (n-1)
 };
