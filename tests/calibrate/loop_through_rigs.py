@@ -15,10 +15,10 @@ One case per run (--case):
                     sample held 70 % A by mass where the model file says 40 %, Table 1's
                     rolling friction; candidates size_distribution (A's
                     mass fraction, and the height spread) and rolling friction; the heaps and
-                    the cups of organic glass and galvanized steel, all of sample "mix".
-                    Run by hand, not in CTest: it fails the 2-sigma check (session 44: verdict
-                    right, chi2/dof 12.25 -> 0.57, A's share fitted 0.667 +/- 0.008 for a truth
-                    of 0.7; the stated uncertainty is too small, docs/calibrate.md).
+                    the cups of organic glass and galvanized steel, all of sample "mix"
+                    (session 45: A's share 0.669 +/- 0.060, chi2/dof 12.90 -> 1.20; before the
+                    surrogate weighed its points by their own scatter, 0.667 +/- 0.008, the
+                    stated uncertainty 7 times too small: docs/calibrate.md).
 
 A truth model (pill A, 12 spheres; with D for the mixture) makes synthetic lab data with `clumpkit synth` (3 % noise, 2
 truth repeats); the baseline is diagnosed against it with `clumpkit diagnose --apply`, then the
