@@ -83,7 +83,8 @@ double Surrogate::value(const std::string& key, double theta) const {
 }
 
 Surrogate Surrogate::redrawn(std::mt19937_64& rng) const {
-  for (const auto& [key, x] : points.front().second) scatter_var(key);
+  if (!points.empty())
+    for (const auto& [key, x] : points.front().second) scatter_var(key);
   Surrogate r = *this;  // with this surrogate's scatter_var
   r.coef.clear();
   std::normal_distribution<double> g(0.0, 1.0);

@@ -126,9 +126,9 @@ struct Fit {
 /// points give the same sigma). The Delta chi2 interval takes the curve as exact; a curve
 /// through a few noisy means has an uncertain slope. On the stand-in with noisy runs the truth
 /// fell within 1 stated sigma in 31 of 40 trials with the redraws, 26 without (nominal 27). The
-/// 95 % interval widens in proportion. Not caught: a steep local slope that the points' assumed
-/// noise supports (session 44's mixture: one heap's five refinement points rose 4.4 deg over
-/// 0.03 of A's share, the fit 0.667 +/- 0.008 for a truth of 0.7; docs/calibrate.md).
+/// 95 % interval widens in proportion. The redraws do not widen sigma where the points' assumed
+/// noise is too small: session 44's mixture (one heap's refinement means rose 4.4 deg over 0.03
+/// of A's share, the fit 0.667 +/- 0.008 for a truth of 0.7) needed Surrogate::scatter_var.
 Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
                   double lo, double hi, int redraws = 32);
 
