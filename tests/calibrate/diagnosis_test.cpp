@@ -57,6 +57,27 @@ struct Hidden {
   double truth;
 };
 
+// The heaps on three plates measured as `clumpkit synth` makes them: the truth's mean over 4
+// seeds plus 3 % lab noise, the stated std widened by the truth's own standard error.
+std::vector<Measurement> heaps_as_synth_makes_them(Simulator& sim, const ParticleModel& truth,
+                                                   std::uint64_t seed) {
+  auto ms = parse_measurements(
+      "rig,sample,setting,quantity,value,std,n,unit\n"
+      "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
+      "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
+      "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n",
+      "template.csv");
+  const auto sims = simulate_measurements(sim, truth, ms, "mini", 4, seed);
+  std::mt19937_64 rng(seed);
+  for (auto& m : ms) {
+    const SimulatedValue& v = sims.at(m.key());
+    const double lab = 0.03 * v.mean;
+    m.value = v.mean + std::normal_distribution<double>(0.0, lab / std::sqrt(m.n))(rng);
+    m.std = std::sqrt(lab * lab + m.n * v.std * v.std / v.n);
+  }
+  return ms;
+}
+
 }  // namespace
 
 // Seeded end-to-end test of the logic on the analytic stand-in: for each hidden effect, the
@@ -124,23 +145,7 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
     set_model_effect(base, "effects.rolling_friction", "0.05", "test");
     ParticleModel truth = base;
     set_model_effect(truth, "effects.rolling_friction", "0.2", "test");
-    // Lab data as `clumpkit synth` makes them: the truth's mean over 4 seeds plus 3 % lab noise,
-    // the stated std widened by the truth's own standard error.
-    auto ms = parse_measurements(
-        "rig,sample,setting,quantity,value,std,n,unit\n"
-        "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n",
-        "template.csv");
-    const std::uint64_t seed = 9000 + 17 * t;
-    const auto sims = simulate_measurements(sim, truth, ms, "mini", 4, seed);
-    std::mt19937_64 rng(seed);
-    for (auto& m : ms) {
-      const SimulatedValue& v = sims.at(m.key());
-      const double lab = 0.03 * v.mean;
-      m.value = v.mean + std::normal_distribution<double>(0.0, lab / std::sqrt(m.n))(rng);
-      m.std = std::sqrt(lab * lab + m.n * v.std * v.std / v.n);
-    }
+    const auto ms = heaps_as_synth_makes_them(sim, truth, 9000 + 17 * t);
     DiagnoseOptions o;
     o.effects = {"rolling_friction", "wall_friction"};
     o.suggest = false;
@@ -195,21 +200,7 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenVariantsScatterMoreThanTheirR
     set_model_effect(base, "effects.rolling_friction", "0.05", "test");
     ParticleModel truth = base;
     set_model_effect(truth, "effects.rolling_friction", "0.2", "test");
-    auto ms = parse_measurements(
-        "rig,sample,setting,quantity,value,std,n,unit\n"
-        "angle_of_repose,A,plate=galvanized_steel,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=abs_plastic,angle,1,1,3,deg\n"
-        "angle_of_repose,A,plate=organic_glass,angle,1,1,3,deg\n",
-        "template.csv");
-    const std::uint64_t seed = 7000 + 13 * t;
-    const auto sims = simulate_measurements(lab_sim, truth, ms, "mini", 4, seed);
-    std::mt19937_64 rng(seed);
-    for (auto& m : ms) {
-      const SimulatedValue& v = sims.at(m.key());
-      const double lab = 0.03 * v.mean;
-      m.value = v.mean + std::normal_distribution<double>(0.0, lab / std::sqrt(m.n))(rng);
-      m.std = std::sqrt(lab * lab + m.n * v.std * v.std / v.n);
-    }
+    const auto ms = heaps_as_synth_makes_them(lab_sim, truth, 7000 + 13 * t);
     DiagnoseOptions o;
     o.effects = {"rolling_friction"};
     o.suggest = false;
