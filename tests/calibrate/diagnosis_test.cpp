@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <utility>
 
 #include "clumpkit/core/error.hpp"
 #include "fake_simulator.hpp"
@@ -56,6 +57,17 @@ struct Hidden {
   std::string effect, key, value;
   double truth;
 };
+
+// The paper's A12 model as a baseline with rolling friction `base_mu_r` ("off" or a value) and
+// a truth that differs from it in rolling friction only (`truth_mu_r`).
+std::pair<ParticleModel, ParticleModel> rolling_friction_baseline_and_truth(
+    const std::string& base_mu_r, const std::string& truth_mu_r) {
+  ParticleModel base = base_model();
+  set_model_effect(base, "effects.rolling_friction", base_mu_r, "test");
+  ParticleModel truth = base;
+  set_model_effect(truth, "effects.rolling_friction", truth_mu_r, "test");
+  return {base, truth};
+}
 
 // The heaps on three plates measured as `clumpkit synth` makes them: the truth's mean over 4
 // seeds plus 3 % lab noise, the stated std widened by the truth's own standard error.
@@ -141,10 +153,7 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenRunsAreNoisy) {
     fake::FakeSimulator sim;
     sim.noise_rel = 0.08;
     sim.common_random_numbers = false;
-    ParticleModel base = base_model();
-    set_model_effect(base, "effects.rolling_friction", "0.05", "test");
-    ParticleModel truth = base;
-    set_model_effect(truth, "effects.rolling_friction", "0.2", "test");
+    const auto [base, truth] = rolling_friction_baseline_and_truth("0.05", "0.2");
     const auto ms = heaps_as_synth_makes_them(sim, truth, 9000 + 17 * t);
     DiagnoseOptions o;
     o.effects = {"rolling_friction", "wall_friction"};
@@ -196,10 +205,7 @@ TEST(Diagnosis, StatedUncertaintyCoversTheTruthWhenVariantsScatterMoreThanTheirR
     fake::FakeSimulator sim = lab_sim;
     sim.variant_noise_rel = 0.06;
     sim.variant_seed = 31 + t;
-    ParticleModel base = base_model();
-    set_model_effect(base, "effects.rolling_friction", "0.05", "test");
-    ParticleModel truth = base;
-    set_model_effect(truth, "effects.rolling_friction", "0.2", "test");
+    const auto [base, truth] = rolling_friction_baseline_and_truth("0.05", "0.2");
     const auto ms = heaps_as_synth_makes_them(lab_sim, truth, 7000 + 13 * t);
     DiagnoseOptions o;
     o.effects = {"rolling_friction"};
@@ -707,10 +713,7 @@ TEST(Diagnosis, SkippingHopelessConfirmationsChangesNoVerdict) {
 // The next measurement is a setting of the experiment (a cup or plate material, a wheel speed),
 // never one of the simulation (scale, stiffness, implicit damping).
 TEST(Diagnosis, SuggestsOnlyExperimentalSettings) {
-  ParticleModel base = base_model();
-  set_model_effect(base, "effects.rolling_friction", "off", "test");
-  ParticleModel truth = base;
-  set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
+  const auto [base, truth] = rolling_friction_baseline_and_truth("off", "0.12");
   fake::FakeSimulator sim;
   auto ms = synthesize(sim, truth, 0.02, 99);
   ms.resize(3);  // the three cups only: the plates and the wheel speeds are left to suggest
@@ -735,10 +738,7 @@ TEST(Diagnosis, SuggestsOnlyExperimentalSettings) {
 // consistent with the data, nor for a decisive verdict (each says why in the summary), but when
 // two effects explain the data alike.
 TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
-  ParticleModel base = base_model();
-  set_model_effect(base, "effects.rolling_friction", "off", "test");
-  ParticleModel truth = base;
-  set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
+  const auto [base, truth] = rolling_friction_baseline_and_truth("off", "0.12");
   DiagnoseOptions o;
   o.effects = {"rolling_friction", "cohesion", "particle_friction"};
   // Heap angles alone, and the two effects that raise them alike.
@@ -815,10 +815,7 @@ TEST(Diagnosis, AMeasurementIsSuggestedOnlyWhereOneIsNeeded) {
 // the verdict is cohesion alone at ~1.4e4 J/m^3 for 9000, chi2/dof 2.6 (p 0.007), and the
 // diagnosis of that model says "consistent".
 TEST(Diagnosis, TwoHiddenEffectsAreFoundTogether) {
-  ParticleModel base = base_model();
-  set_model_effect(base, "effects.rolling_friction", "off", "test");
-  ParticleModel truth = base;
-  set_model_effect(truth, "effects.rolling_friction", "0.12", "test");
+  auto [base, truth] = rolling_friction_baseline_and_truth("off", "0.12");
   set_model_effect(truth, "effects.cohesion", "9000 J/m^3", "test");
   fake::FakeSimulator sim;
   const auto ms = synthesize(sim, truth, 0.02, 23);

@@ -38,16 +38,18 @@ void Surrogate::aim(double theta, const Values& pooled, const SpreadPool* pool) 
 double Surrogate::scatter_var(const std::string& key) const {
   const auto rv = run_var.find(key);
   if (rv == run_var.end()) return 0.0;
-  const auto fk = family.find(key);
-  const std::string& fam = fk == family.end() ? key : fk->second;
+  auto family_of = [&](const std::string& k) -> const std::string& {
+    const auto f = family.find(k);
+    return f == family.end() ? k : f->second;
+  };
+  const std::string& fam = family_of(key);
   auto known = scatter.find(fam);
   if (known == scatter.end()) {
     double sum = 0.0;  // pseudo-residuals squared, each in units of its observable's run variance
     int k = 0;
     const double span = points.empty() ? 0.0 : points.back().first - points.front().first;
     for (const auto& [other, var] : run_var) {
-      const auto fo = family.find(other);
-      if ((fo == family.end() ? other : fo->second) != fam) continue;
+      if (family_of(other) != fam) continue;
       for (size_t i = 1; i + 1 < points.size(); ++i) {
         const double t0 = points[i - 1].first, t1 = points[i].first, t2 = points[i + 1].first;
         if (t2 - t0 > kNeighbourSpan * span) continue;
