@@ -70,7 +70,11 @@ double Surrogate::scatter_var(const std::string& key) const {
 }
 
 double Surrogate::value(const std::string& key, double theta) const {
-  const Poly& c = poly(key);
+  return curve(key)(theta);
+}
+
+double Surrogate::Curve::operator()(double theta) const {
+  const Poly& c = p_;
   auto at = [&](double t) {
     const double x = (t - c.mid) / c.half;
     return c.a + x * (c.b + x * c.c);
@@ -243,14 +247,30 @@ std::vector<double> fit_variances(const std::vector<Measurement>& ms, const Valu
   return var;
 }
 
+namespace {
+
+std::vector<Surrogate::Curve> curves_of(const std::vector<Measurement>& ms, const Surrogate& s) {
+  std::vector<Surrogate::Curve> curves;
+  curves.reserve(ms.size());
+  for (const auto& m : ms) curves.push_back(s.curve(m.key()));
+  return curves;
+}
+
+}  // namespace
+
 double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& var,
-               const Surrogate& s, double theta) {
+               const std::vector<Surrogate::Curve>& curves, double theta) {
   double chi2 = 0;
   for (size_t i = 0; i < ms.size(); ++i) {
-    const double d = s.value(ms[i].key(), theta) - ms[i].value;
+    const double d = curves[i](theta) - ms[i].value;
     chi2 += d * d / var[i];
   }
   return chi2;
+}
+
+double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& var,
+               const Surrogate& s, double theta) {
+  return chi2_of(ms, var, curves_of(ms, s), theta);
 }
 
 Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const Surrogate& s,
@@ -261,9 +281,10 @@ Fit fit_surrogate(const std::vector<Measurement>& ms, const Values& base, const 
   f.chi2 = std::numeric_limits<double>::infinity();
   int best = 0;
   const std::vector<double> var = fit_variances(ms, base, s);
+  const std::vector<Surrogate::Curve> curves = curves_of(ms, s);
   for (int i = 0; i <= n; ++i) {
     th[i] = lo + (hi - lo) * i / n;
-    c[i] = chi2_of(ms, var, s, th[i]);
+    c[i] = chi2_of(ms, var, curves, th[i]);
     if (c[i] < f.chi2) {
       f.chi2 = c[i];
       best = i;
@@ -321,10 +342,11 @@ PairFitResult fit_pair(const std::vector<Measurement>& ms, const Values& pooled,
   std::vector<double> da((kGrid + 1) * n), db((kGrid + 1) * n);
   for (size_t k = 0; k < n; ++k) {
     const std::string key = ms[k].key();
-    const double a0 = a.value(key, base_a), b0 = b.value(key, base_b);
+    const Surrogate::Curve ca = a.curve(key), cb = b.curve(key);
+    const double a0 = ca(base_a), b0 = cb(base_b);
     for (int i = 0; i <= kGrid; ++i) {
-      da[i * n + k] = a.value(key, axis(range_a, i)) - a0;
-      db[i * n + k] = b.value(key, axis(range_b, i)) - b0;
+      da[i * n + k] = ca(axis(range_a, i)) - a0;
+      db[i * n + k] = cb(axis(range_b, i)) - b0;
     }
   }
   // The residual at the baselines: the baseline's mean (a's surrogate there) against the data.

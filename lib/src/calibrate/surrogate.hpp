@@ -29,6 +29,12 @@ using Values = std::map<std::string, SimulatedValue>;
 /// chi2 test at 1 %), the points farthest from the `focus` (where the fit is being made) are
 /// dropped, down to three, so the surrogate is local where it must be and smooth where it can be.
 class Surrogate {
+ private:
+  struct Poly {
+    double mid = 0, half = 1, a = 0, b = 0, c = 0;  ///< a + b x + c x^2, x = (t - mid) / half
+    double lo = 0, hi = 0;                          ///< span of the points it follows
+  };
+
  public:
   /// A fit misses its points by more than their seed noise when a miss this large has a
   /// probability below this (chi2 test).
@@ -43,6 +49,19 @@ class Surrogate {
   void aim(double theta, const Values& pooled, const SpreadPool* pool = nullptr);
   /// The surrogate's mean of observable `key` at `theta`.
   double value(const std::string& key, double theta) const;
+  /// The surrogate's curve of one observable, evaluated like value() without looking the
+  /// observable up: a fit's grid evaluates it thousands of times. A copy, valid until the
+  /// surrogate's points or aim change.
+  class Curve {
+   public:
+    double operator()(double theta) const;
+
+   private:
+    friend class Surrogate;
+    explicit Curve(const Poly& p) : p_(p) {}
+    Poly p_;
+  };
+  Curve curve(const std::string& key) const { return Curve(poly(key)); }
   /// A copy whose points' means are redrawn within their seed noise (one run's variance:
   /// scatter_var, else, where the surrogate was not aimed, the point's own spread; std^2 / n
   /// for a mean of n repeats). Fitted again, it shows how far the fit moves with the surrogate's
@@ -72,10 +91,6 @@ class Surrogate {
   double scatter_var(const std::string& key) const;
 
  private:
-  struct Poly {
-    double mid = 0, half = 1, a = 0, b = 0, c = 0;  ///< a + b x + c x^2, x = (t - mid) / half
-    double lo = 0, hi = 0;                          ///< span of the points it follows
-  };
   /// (theta, mean, repeats) of the points, for one observable.
   struct Pt {
     double t, y;
@@ -113,6 +128,9 @@ std::vector<double> fit_variances(const std::vector<Measurement>& ms, const Valu
 /// chi2 of the measurements against the surrogate at `theta`, with the variances `var`.
 double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& var,
                const Surrogate& s, double theta);
+/// The same with the surrogate's curves of the measurements (`curves[i]` that of `ms[i]`).
+double chi2_of(const std::vector<Measurement>& ms, const std::vector<double>& var,
+               const std::vector<Surrogate::Curve>& curves, double theta);
 
 /// One candidate's strength fitted on its surrogate.
 struct Fit {
