@@ -1,5 +1,5 @@
 // The diagnosis's response surrogate (lib/src/calibrate/surrogate.hpp): the run variance it
-// weighs its points by, in closed form.
+// weighs its points by and its curves, in closed form.
 #include <gtest/gtest.h>
 
 #include "calibrate/surrogate.hpp"
@@ -108,4 +108,26 @@ TEST(Surrogate, ARedrawnCopyKeepsTheOriginalsScatter) {
 }
 
 }  // namespace
+// A curve evaluates its observable as value() does: the parabola through three points
+// (y = 1 + t^2 at t = 1, 2, 3) between them, its tangent beyond them; and chi2_of from the
+// curves equals chi2_of from the surrogate.
+TEST(Surrogate, ACurveIsTheSurrogatesValue) {
+  const std::string k = heap("abs_plastic").key(), kc = cup().key();
+  Surrogate s;
+  for (double t : {1.0, 2.0, 3.0})
+    s.add(t, {{k, {1.0 + t * t, 0.1, 2}}, {kc, {500.0 - t, 1.0, 2}}});
+  const Surrogate::Curve c = s.curve(k);
+  for (double t : {0.0, 1.0, 1.5, 2.5, 3.0, 4.0}) EXPECT_EQ(c(t), s.value(k, t)) << t;
+  EXPECT_NEAR(c(2.5), 1.0 + 2.5 * 2.5, 1e-12);
+  EXPECT_NEAR(c(4.0), 10.0 + 6.0, 1e-12) << "beyond the points: the tangent at t = 3";
+  EXPECT_NEAR(c(0.0), 2.0 - 2.0, 1e-12) << "before them: the tangent at t = 1";
+  Measurement mh = heap("abs_plastic"), mc = cup();
+  mh.value = 8.0, mc.value = 498.0;
+  const std::vector<Measurement> ms = {mh, mc};
+  const std::vector<double> var = {0.5, 2.0};
+  const std::vector<Surrogate::Curve> curves = {s.curve(k), s.curve(kc)};
+  for (double t : {0.0, 1.3, 3.5}) EXPECT_EQ(chi2_of(ms, var, curves, t), chi2_of(ms, var, s, t));
+  EXPECT_NEAR(chi2_of(ms, var, s, 3.0), (10.0 - 8.0) * (10.0 - 8.0) / 0.5 + 1.0 / 2.0, 1e-9);
+}
+
 }  // namespace clumpkit::calibrate
