@@ -900,3 +900,40 @@ TEST(Diagnosis, FindsAHiddenMixtureFraction) {
   const Diagnosis d2 = diagnose(next, ms, sim2, o);
   EXPECT_TRUE(d2.consistent) << d2.summary();
 }
+
+// No verdict is not always a clean bill of health: a baseline that misses the data by more than
+// noise usually does (p below the screen's 0.05) but not enough for a verdict (p >= 0.01) is
+// called a marginal fit, with the leading candidates and their weights, not "consistent".
+TEST(Diagnosis, AMarginalMisfitWithoutAVerdictIsNotCalledConsistent) {
+  Diagnosis d;
+  d.consistent = true;
+  d.baseline.chi2 = 13.05;
+  d.baseline.observables.resize(4);
+  d.confidence = 0.02;
+  for (const auto& [effect, weight] : {std::pair<std::string, double>{"cohesion", 0.57},
+                                       {"particle_friction", 0.21},
+                                       {"rolling_friction", 0.20}}) {
+    CandidateResult c;
+    c.candidate.effect = effect;
+    c.weight = weight;
+    d.candidates.push_back(c);
+  }
+  d.baseline_p = 0.011;
+  const std::string marginal = d.summary();
+  EXPECT_NE(marginal.find("no effect is named, but the model fits the data only marginally "
+                          "(p = 0.011, baseline weight 0.02; a verdict needs p < 0.01"),
+            std::string::npos)
+      << marginal;
+  EXPECT_NE(marginal.find("'cohesion' (weight 0.57), 'particle_friction' (weight 0.21), "
+                          "'rolling_friction' (weight 0.20)"),
+            std::string::npos)
+      << marginal;
+  EXPECT_EQ(marginal.find("consistent with the data"), std::string::npos) << marginal;
+  d.baseline_p = 0.3;
+  const std::string consistent = d.summary();
+  EXPECT_NE(consistent.find("verdict: the model is consistent with the data"), std::string::npos)
+      << consistent;
+  d.baseline_p = 0.011;
+  d.screen_only = true;  // a screen-only diagnosis saw p >= 0.05 after its screen
+  EXPECT_NE(d.summary().find("consistent with the data"), std::string::npos);
+}

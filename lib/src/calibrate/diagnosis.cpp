@@ -676,6 +676,9 @@ double Diagnoser::rank() {
   d.baseline = compare(ms, pool.pooled(s0), 0);
   d.baseline_bic = d.baseline.bic;
   d.baseline_p = chi2_survival(d.baseline.chi2, n);
+  d.p_inconsistent = o.p_inconsistent;
+  d.p_screen_only = o.p_screen_only;
+  d.min_delta_bic = o.min_delta_bic;
   for (Work& w : work) {
     if (w.dropped) continue;
     CandidateResult r;
@@ -796,7 +799,20 @@ std::string Diagnosis::summary() const {
   std::string s;
   s += fmt::format("baseline: chi2 = {:.2f} for {} observables (chi2/dof {:.2f}, p = {:.3g})\n",
                    baseline.chi2, baseline.observables.size(), baseline.chi2_per_dof, baseline_p);
-  if (consistent) {
+  // No verdict, but the baseline misfits the data more than noise usually does (p below the
+  // screen's threshold): "consistent" would read as a clean bill of health.
+  const bool marginal =
+      consistent && !screen_only && !candidates.empty() && baseline_p < p_screen_only;
+  if (marginal) {
+    s += fmt::format(
+        "verdict: no effect is named, but the model fits the data only marginally (p = {:.3g}, "
+        "baseline weight {:.2f}; a verdict needs p < {:g} and a BIC gain of {:g}). Leading:",
+        baseline_p, confidence, p_inconsistent, min_delta_bic);
+    for (size_t i = 0; i < candidates.size() && i < 3; ++i)
+      s += fmt::format("{} '{}' (weight {:.2f})", i ? "," : "", candidates[i].candidate.effect,
+                       candidates[i].weight);
+    s += ". More measurements, or more precise ones, would tell whether one is missing.\n";
+  } else if (consistent) {
     s += fmt::format(
         "verdict: the model is consistent with the data; no effect improves it decisively "
         "(baseline weight {:.2f})\n",

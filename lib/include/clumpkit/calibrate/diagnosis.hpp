@@ -131,6 +131,8 @@ struct Diagnosis {
   std::vector<Suggestion> suggestions;         ///< best first
   std::string suggestion_note;  ///< why no measurement was suggested (empty when one was)
   long simulations = 0;         ///< rig runs made (not served by the cache)
+  /// The thresholds the verdict was given by (DiagnoseOptions), for the summary's words.
+  double p_inconsistent = 0.01, p_screen_only = 0.05, min_delta_bic = 6.0;
   std::string summary() const;  ///< the verdict in words
 };
 
