@@ -291,6 +291,11 @@ Command setup_diagnose(CLI::App& parent) {
                            : "no (at bound)",
               chi2_source_text(r));
         for (const auto& r : d.candidates)
+          if (r.interval_past_runs()) {
+            std::cout << kIntervalPastRunsNote << "\n";
+            break;
+          }
+        for (const auto& r : d.candidates)
           if (!r.limit.empty())
             std::cout << "limit: " << r.candidate.effect << ": " << r.limit << "\n";
         for (const auto& s : d.skipped) std::cout << "not tried: " << s << "\n";
@@ -324,6 +329,9 @@ Command setup_diagnose(CLI::App& parent) {
                         {"at_limit", r.at_limit},
                         {"chi2_source", r.chi2_source},
                         {"chi2_at", r.chi2_at},
+                        {"runs_span", r.candidate.discrete || r.with ? json(nullptr)
+                                                                     : json{r.runs_lo, r.runs_hi}},
+                        {"interval_past_runs", r.interval_past_runs()},
                         {"with", r.with ? fit_json(r.with->candidate, r.with->fitted, r.with->std,
                                                    r.with->lo, r.with->hi)
                                         : json(nullptr)}});

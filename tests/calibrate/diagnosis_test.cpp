@@ -937,3 +937,39 @@ TEST(Diagnosis, AMarginalMisfitWithoutAVerdictIsNotCalledConsistent) {
   d.screen_only = true;  // a screen-only diagnosis saw p >= 0.05 after its screen
   EXPECT_NE(d.summary().find("consistent with the data"), std::string::npos);
 }
+
+// A 95 % interval that reaches past the strengths simulated for a candidate (by more than 5 %
+// of their span) rests on the surrogate's straight continuation there: the interval is marked
+// "*" and the verdict says so.
+TEST(Diagnosis, AnIntervalPastTheRunsIsMarked) {
+  CandidateResult r;
+  r.candidate.effect = "cohesion";
+  r.candidate.parameter = "SJKR energy density, pill-pill";
+  r.candidate.unit = "J/m^3";
+  r.fitted = 6275, r.fitted_std = 1950, r.fitted_lo = 1859, r.fitted_hi = 9821;
+  r.runs_lo = 0, r.runs_hi = 8000;
+  EXPECT_TRUE(r.interval_past_runs());
+  EXPECT_EQ(interval_text(r), "1.86e+03 to 9.82e+03*");
+  r.fitted_hi = 8300;  // within 5 % of the span past the last run: the tangent's job
+  EXPECT_FALSE(r.interval_past_runs());
+  EXPECT_EQ(interval_text(r), "1.86e+03 to 8.3e+03");
+  r.fitted_lo = -500;  // past the first run
+  EXPECT_TRUE(r.interval_past_runs());
+  r.runs_hi = r.runs_lo;  // span unknown (discrete, pairs)
+  EXPECT_FALSE(r.interval_past_runs());
+
+  Diagnosis d;
+  d.consistent = false;
+  d.verdict = "cohesion";
+  d.confidence = 0.9;
+  d.baseline_p = 1e-4;
+  r.fitted_lo = 1859, r.fitted_hi = 9821, r.runs_hi = 8000;
+  d.candidates.push_back(r);
+  const std::string s = d.summary();
+  EXPECT_NE(s.find("note: the 95 % interval reaches past the strengths simulated for it (0 J/m^3 "
+                   "to 8000 J/m^3)"),
+            std::string::npos)
+      << s;
+  d.candidates.front().fitted_hi = 7000;
+  EXPECT_EQ(d.summary().find("note: the 95 %"), std::string::npos);
+}

@@ -687,6 +687,10 @@ double Diagnoser::rank() {
     r.fitted_std = w.fit.sigma;
     r.fitted_lo = w.c.discrete ? r.fitted : w.fit.lo95;
     r.fitted_hi = w.c.discrete ? r.fitted : w.fit.hi95;
+    if (!w.c.discrete && !w.s.points.empty()) {
+      r.runs_lo = w.s.points.front().first;
+      r.runs_hi = w.s.points.back().first;
+    }
     // A surrogate's values keep the spread the fit gave them; a run's are pooled.
     r.comparison = compare(ms, w.source == "surrogate" ? w.at_fit : pool.pooled(w.at_fit), 1);
     r.chi2_source = w.source;
@@ -773,9 +777,17 @@ double Diagnoser::rank() {
 
 }  // namespace
 
+bool CandidateResult::interval_past_runs() const {
+  if (candidate.discrete || with || !(runs_hi > runs_lo)) return false;
+  // A little past the runs is the tangent's job (a 95 % end a hair beyond a bound run).
+  const double tol = 0.05 * (runs_hi - runs_lo);
+  return fitted_lo < runs_lo - tol || fitted_hi > runs_hi + tol;
+}
+
 std::string interval_text(const CandidateResult& r) {
   if (r.candidate.discrete) return "-";
-  return fmt::format("{:.3g} to {:.3g}", r.fitted_lo, r.fitted_hi);
+  return fmt::format("{:.3g} to {:.3g}{}", r.fitted_lo, r.fitted_hi,
+                     r.interval_past_runs() ? "*" : "");
 }
 
 std::string parameter_text(const CandidateResult& r) {
@@ -843,6 +855,11 @@ std::string Diagnosis::summary() const {
     else if (!t.plausible)
       s += "  warning: the fitted value is pinned at the edge of its physical range: the effect "
            "it stands for may be the wrong one\n";
+    if (t.interval_past_runs())
+      s += fmt::format(
+          "  note: the 95 % interval reaches past the strengths simulated for it ({} to {}): "
+          "there the response is the surrogate's straight continuation, not a run\n",
+          t.candidate.format(t.runs_lo), t.candidate.format(t.runs_hi));
     for (const auto& dr : drivers) s += "  driven by " + dr + "\n";
     if (!indistinguishable.empty()) {
       s += "  indistinguishable on these data from:";

@@ -226,6 +226,9 @@ std::string report_html(const ReportInput& in) {
                        : "no",
           esc(chi2_source_text(r)));
     h += "</table>\n";
+    if (std::any_of(in.diagnosis->candidates.begin(), in.diagnosis->candidates.end(),
+                    [](const CandidateResult& r) { return r.interval_past_runs(); }))
+      h += "<p class=\"limit\">" + esc(kIntervalPastRunsNote) + "</p>\n";
     for (const auto& r : in.diagnosis->candidates)
       if (!r.limit.empty())
         h += "<p class=\"limit\">" + esc(r.candidate.effect + ": " + r.limit) + "</p>\n";

@@ -80,6 +80,14 @@ struct CandidateResult {
   /// asymmetric where a response levels off (fitted_std, the Delta chi2 = 1 half-width, is then
   /// short on the flat side); an open side reaches the fit's range. Discrete: both = fitted.
   double fitted_lo = 0.0, fitted_hi = 0.0;
+  /// The span of the strengths simulated for this candidate (the baseline's included). Where
+  /// the 95 % interval reaches past it, the response there is the surrogate's straight
+  /// continuation, not a run: a response that levels off past the last run (cohesion) makes
+  /// that side of the interval too short. Equal when not known (discrete, pairs).
+  double runs_lo = 0.0, runs_hi = 0.0;
+  /// Whether the 95 % interval reaches past the simulated span by more than 5 % of it
+  /// (interval_text marks it "*").
+  bool interval_past_runs() const;
   Comparison comparison;  ///< against the data, at `chi2_at` (see chi2_source)
   /// How `comparison` was obtained: "run" (a simulation at `fitted`), "screen" (a discrete
   /// level's one-repeat screening run, Diagnosis::screen_only), "nearest_run" (the
@@ -141,8 +149,13 @@ Diagnosis diagnose(const ParticleModel& baseline, const std::vector<Measurement>
 
 /// Where a candidate's chi2 comes from, in words: "run", "run at <value>" or "surrogate".
 std::string chi2_source_text(const CandidateResult& r);
-/// "0.17 to 0.23" (the 95 % interval, in the parameter's unit), "-" for a discrete candidate.
+/// "0.17 to 0.23" (the 95 % interval, in the parameter's unit), "-" for a discrete candidate;
+/// "0.17 to 0.23*" where it reaches past the candidate's runs (interval_past_runs).
 std::string interval_text(const CandidateResult& r);
+/// The footnote of a candidates table with a "*" interval.
+inline constexpr const char* kIntervalPastRunsNote =
+    "* 95 % interval past the strengths simulated for the candidate: there the response is the "
+    "surrogate's straight continuation, not a run";
 /// The candidate's parameter, and a pair's second one with its value: "mu_r (with cohesion:
 /// SJKR energy density = 8750 J/m^3)".
 std::string parameter_text(const CandidateResult& r);
