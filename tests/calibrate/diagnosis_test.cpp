@@ -929,6 +929,12 @@ TEST(Diagnosis, AMarginalMisfitWithoutAVerdictIsNotCalledConsistent) {
             std::string::npos)
       << marginal;
   EXPECT_EQ(marginal.find("consistent with the data"), std::string::npos) << marginal;
+  d.baseline_p = 0.003;  // a misfit, but no candidate decisive
+  const std::string missed = d.summary();
+  EXPECT_NE(missed.find("no effect is named, though the model misses the data (p = 0.003"),
+            std::string::npos)
+      << missed;
+  EXPECT_NE(missed.find("'cohesion' (weight 0.57)"), std::string::npos) << missed;
   d.baseline_p = 0.3;
   const std::string consistent = d.summary();
   EXPECT_NE(consistent.find("verdict: the model is consistent with the data"), std::string::npos)

@@ -816,10 +816,19 @@ std::string Diagnosis::summary() const {
   const bool marginal =
       consistent && !screen_only && !candidates.empty() && baseline_p < p_screen_only;
   if (marginal) {
-    s += fmt::format(
-        "verdict: no effect is named, but the model fits the data only marginally (p = {:.3g}, "
-        "baseline weight {:.2f}; a verdict needs p < {:g} and a BIC gain of {:g}). Leading:",
-        baseline_p, confidence, p_inconsistent, min_delta_bic);
+    // p < p_inconsistent: the model misses the data, but no candidate gains the BIC a verdict
+    // needs; above it, the misfit itself is too small for a verdict.
+    s += baseline_p < p_inconsistent
+             ? fmt::format(
+                   "verdict: no effect is named, though the model misses the data (p = {:.3g}, "
+                   "baseline weight {:.2f}): no candidate improves the BIC by the {:g} a verdict "
+                   "needs. Leading:",
+                   baseline_p, confidence, min_delta_bic)
+             : fmt::format(
+                   "verdict: no effect is named, but the model fits the data only marginally (p "
+                   "= {:.3g}, baseline weight {:.2f}; a verdict needs p < {:g} and a BIC gain of "
+                   "{:g}). Leading:",
+                   baseline_p, confidence, p_inconsistent, min_delta_bic);
     for (size_t i = 0; i < candidates.size() && i < 3; ++i)
       s += fmt::format("{} '{}' (weight {:.2f})", i ? "," : "", candidates[i].candidate.effect,
                        candidates[i].weight);
