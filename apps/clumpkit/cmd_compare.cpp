@@ -290,11 +290,9 @@ Command setup_diagnose(CLI::App& parent) {
               : r.at_limit ? "no (at limit)"
                            : "no (at bound)",
               chi2_source_text(r));
-        for (const auto& r : d.candidates)
-          if (r.interval_past_runs()) {
-            std::cout << kIntervalPastRunsNote << "\n";
-            break;
-          }
+        if (std::any_of(d.candidates.begin(), d.candidates.end(),
+                        [](const CandidateResult& r) { return r.interval_past_runs(); }))
+          std::cout << kIntervalPastRunsNote << "\n";
         for (const auto& r : d.candidates)
           if (!r.limit.empty())
             std::cout << "limit: " << r.candidate.effect << ": " << r.limit << "\n";
