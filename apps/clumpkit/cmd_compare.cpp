@@ -3,6 +3,7 @@
 #ifdef CLUMPKIT_HAVE_CALIBRATE
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
 #include <optional>
 #include <random>
