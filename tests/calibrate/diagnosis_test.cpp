@@ -398,7 +398,10 @@ TEST(Diagnosis, AFailureAtTheRangesBoundIsNotRunAgain) {
 //   and 14 (accelerating) of 16, plausible 16 and 16, cohesion the verdict in all.
 // Where the response has levelled off the likelihood is skewed and the symmetric sigma short
 // on one side, so the coverage stays below the nominal 95 %; the reported 95 % interval (Delta
-// chi2 = 4 on the surrogate, asymmetric) covers the truth in 13 and 13 of 16.
+// chi2 = 4 on the surrogate, asymmetric) covered the truth in 13 and 13 of 16 when this test was
+// written. Measured again on session 46's code (the surrogate's own noise in the uncertainty, its
+// points weighed by their scatter): 2 sigma 14 and 16, the 95 % interval 15 and 15 of 16; the end
+// runs of session 47 (AnIntervalPastTheRunsGetsARunAtItsEnd) leave these counts as they are.
 TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
   struct Shaped final : Simulator {
     std::function<double(double)> shape;  // cohesion -> the stand-in's (linear) cohesion
@@ -454,8 +457,7 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
     std::cout << name << ": truth within 2 stated sigma in " << covered << ", within the 95 % "
               << "interval in " << covered95 << " of " << trials << "\n";
     EXPECT_GE(covered, 9) << name;
-    // Measured: 13 and 13 of 16 (the 2-sigma counts 11 and 14: the interval gains where the
-    // response levels off and loses a grid step at the edge of a symmetric one).
+    // Measured: 15 and 15 of 16 (session 46's code and since; 13 and 13 when written).
     EXPECT_GE(covered95, 12) << name;
     EXPECT_GE(plausible, trials - 1) << name;
   }
@@ -978,4 +980,71 @@ TEST(Diagnosis, AnIntervalPastTheRunsIsMarked) {
       << s;
   d.candidates.front().fitted_hi = 7000;
   EXPECT_EQ(d.summary().find("note: the 95 %"), std::string::npos);
+}
+
+// A hidden effect far along a response that levels off: a run at the far end of the leaders'
+// 95 % intervals (DiagnoseOptions::bracket_runs) where they reach past the runs. The stand-in's
+// cohesion saturates (7.5e4 (1 - exp(-c / c0)) J/m^3 in its linear law), the truth 1.5e4 J/m^3
+// at 2.5 and at 5 times c0, 16 lab-noise draws each, with and without the end runs. Measured
+// (the 95 % interval covering the truth; intervals still past the runs; cohesion the verdict;
+// simulations over the 16 draws):
+//   c0 6000:  without 15 covered, 9 past, 16 verdicts, 1552 runs; with 15, 0, 16, 1704;
+//   c0 3000:  without  3 covered, 15 past, 12 verdicts, 1600 runs; with 9, 7, 16, 1880.
+// Far along the plateau (c0 3000) a parabola cannot follow the response, so the coverage stays
+// short of 95 %; the intervals that still reach past the runs are marked "*".
+TEST(Diagnosis, AnIntervalPastTheRunsGetsARunAtItsEnd) {
+  struct Saturating final : Simulator {
+    double c0 = 6000.0;
+    fake::FakeSimulator inner;
+    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                       std::uint64_t seed) override {
+      ParticleModel s = m;
+      const double c = m.effects.cohesion.value_or(0.0);
+      if (c > 8e4) throw NumericalError("heap angle: the heap is only 5 mm high: no cone");
+      if (c > 0) s.effects.cohesion = 7.5e4 * (1.0 - std::exp(-c / c0));
+      ++runs_;
+      return inner.simulate(s, r, repeats, seed);
+    }
+  };
+  const double truth_value = 1.5e4;
+  for (const double c0 : {6000.0, 3000.0}) {
+    int covered[2] = {0, 0}, past[2] = {0, 0}, verdicts[2] = {0, 0};
+    for (const int with_ends : {0, 1}) {
+      for (int t = 0; t < 16; ++t) {
+        Saturating sim;
+        sim.c0 = c0;
+        sim.inner.noise_rel = 0.01;
+        sim.inner.common_random_numbers = false;
+        ParticleModel base = base_model();
+        set_model_effect(base, "effects.cohesion", "off", "test");
+        ParticleModel truth = base;
+        set_model_effect(truth, "effects.cohesion", "15000 J/m^3", "test");
+        const auto ms = synthesize(sim, truth, 0.02, 500 + t);
+        DiagnoseOptions o;
+        o.suggest = false;
+        o.bracket_runs = with_ends ? 2 : 0;
+        o.effects = {"cohesion", "rolling_friction", "particle_friction"};
+        o.seed = 1 + 100 * t;
+        const Diagnosis d = diagnose(base, ms, sim, o);
+        verdicts[with_ends] += d.verdict == "cohesion";
+        for (const auto& c : d.candidates)
+          if (c.candidate.effect == "cohesion" && !c.with) {
+            covered[with_ends] += c.fitted_lo <= truth_value && truth_value <= c.fitted_hi;
+            past[with_ends] += c.interval_past_runs();
+            break;
+          }
+      }
+      std::cout << "c0 " << c0 << (with_ends ? ", with" : ", without")
+                << " the end runs: " << covered[with_ends] << " covered, " << past[with_ends]
+                << " past the runs, " << verdicts[with_ends] << " verdicts of 16\n";
+    }
+    // Without the end runs the problem shows; with them, fewer intervals rest on the tangent,
+    // and neither the coverage nor the verdicts are worse.
+    EXPECT_GE(past[0], 6) << c0;
+    EXPECT_LE(past[1], past[0] / 2) << c0;
+    EXPECT_GE(covered[1], covered[0]) << c0;
+    EXPECT_GE(verdicts[1], verdicts[0]) << c0;
+    EXPECT_GE(covered[1], c0 == 6000.0 ? 13 : 7) << c0;
+    EXPECT_GE(verdicts[1], 15) << c0;
+  }
 }

@@ -61,7 +61,8 @@ struct PairWork {
 //   other_sides   where the data are inconsistent with the baseline: one more screening run on
 //                 the unprobed side, or past the probe, where a candidate's fit needs it;
 //   refine        the leading continuous candidates, run at their fitted values until the fit
-//                 stops moving;
+//                 stops moving, and at their 95 % interval's far end where it reaches past
+//                 their runs;
 //   confirm       every candidate that could still lead, run at its fit (discrete: its levels);
 //   fit_pairs     where no single effect explains the data, pairs of effects;
 //   rank          BIC, weights, the verdict and the observables that drive it;
@@ -195,6 +196,7 @@ class Diagnoser {
   void screen();
   void other_sides();
   void refine();
+  double far_end(const Work& w) const;
   void confirm();
   void choose_levels();
   void fit_pairs();
@@ -387,6 +389,17 @@ void Diagnoser::other_sides() {
 // result), so that one step's runs can go side by side. A failed run narrows the candidate's
 // range and costs it no step: up to two failures each are followed by one more refinement
 // (short of the failure) than `refinements`.
+//
+// The ends of the leaders' intervals. Past the strengths simulated for a candidate, its 95 %
+// interval rests on the surrogate's straight continuation (the tangent at the last run), too
+// steep where the response levels off, so the interval is too narrow on that side: a hidden
+// cohesion of 1.5e4 J/m^3 gives the tiny heaps and cups of ~6000 J/m^3, and with runs at 0,
+// 5925 and 8000 it was fitted at 6275, 95 % up to 9820. So a candidate whose refinement has
+// stopped, whose fit is within min_delta_bic of the leading fit and whose interval reaches past
+// its runs is run (every repeat) at the interval's far end (far_end), up to bracket_runs times.
+// The new point can move the fit (a parabola through a levelling-off response turns over
+// there): where it moves by more than a quarter of its uncertainty, the refinement goes on at
+// the new fit, with `refinements` more steps.
 void Diagnoser::refine() {
   std::vector<size_t> order(work.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -396,30 +409,45 @@ void Diagnoser::refine() {
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < o.refine_top; ++r)
     if (!work[order[r]].c.discrete && o.refinements > 0 && !screen_only)
       refining.push_back(&work[order[r]]);
+  std::map<const Work*, double> at_end;  // a candidate's next run is at its interval's end
+  std::map<const Work*, int> ends_left;
+  for (Work* w : refining) ends_left[w] = o.bracket_runs;
   while (!refining.empty()) {
     std::vector<ParticleModel> models;
-    for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
+    auto run_at = [&](const Work* w) {
+      auto e = at_end.find(w);
+      return e != at_end.end() ? e->second : w->fit.theta;
+    };
+    for (Work* w : refining) models.push_back(w->c.apply(base, run_at(w)));
     prefetch(models, o.repeats);
     std::vector<Work*> still;
     for (Work* w : refining) {
-      say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
+      const double x = run_at(w);
+      const bool end = at_end.erase(w) > 0;
+      if (end)
+        say(fmt::format("{}: its 95 % interval ({} to {}) reaches past its runs; running at {}",
+                        w->c.effect, w->c.format(w->fit.lo95), w->c.format(w->fit.hi95),
+                        w->c.format(x)));
+      else
+        say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(x)));
       int& left = w->steps_left;
-      --left;
-      Values v;
+      if (!end) --left;
+      bool converged = false;
       try {
-        v = simulate(w->c.apply(base, w->fit.theta), o.repeats);
+        Values v = simulate(w->c.apply(base, x), o.repeats);
+        w->s.add(x, std::move(v));
+        const Fit next = refit(*w);
+        converged = std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
+        w->fit = next;
       } catch (const NumericalError& e) {
-        cannot_measure(*w, w->fit.theta, e.what());
-        w->fit = refit(*w);
-        if (w->failures <= 2) ++left;
-        if (left > 0) still.push_back(w);
-        continue;
+        cannot_measure(*w, x, e.what());
+        const Fit next = refit(*w);
+        converged =
+            end && std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
+        w->fit = next;
+        if (!end && w->failures <= 2) ++left;
       }
-      w->s.add(w->fit.theta, v);
-      const Fit next = refit(*w);
-      const bool converged =
-          std::abs(next.theta - w->fit.theta) <= 0.25 * std::max(next.sigma, 1e-12);
-      w->fit = next;
+      if (end && !converged) left = std::max(left, o.refinements);
       if (!converged && left == 0 && w->extra_left > 0 && inconsistent) {
         // The leader (by the surrogates' chi2) gets a few more steps to converge, where there is
         // a misfit to converge on (with data the baseline already explains, its fit wanders
@@ -433,10 +461,40 @@ void Diagnoser::refine() {
           ++left;
         }
       }
-      if (!converged && left > 0) still.push_back(w);
+      if (!converged && left > 0) {
+        still.push_back(w);
+        continue;
+      }
+      // Stopped: its interval's end, where that is past its runs and it could lead.
+      double best = std::numeric_limits<double>::infinity();
+      for (const Work& other : work)
+        if (!other.dropped) best = std::min(best, other.fit.chi2);
+      const double far = far_end(*w);
+      if (ends_left[w] > 0 && !std::isnan(far) && w->fit.chi2 <= best + o.min_delta_bic) {
+        --ends_left[w];
+        at_end[w] = far;
+        still.push_back(w);
+      }
     }
     refining = still;
   }
+}
+
+// The far end of a continuous candidate's 95 % interval where it reaches past the strengths
+// simulated for it by more than 5 % of their span (CandidateResult::interval_past_runs), kept
+// within the range a fit may use; of two such ends, the one further past. NaN: none.
+double Diagnoser::far_end(const Work& w) const {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  if (w.c.discrete || w.s.points.size() < 2) return kNone;
+  const double runs_lo = w.s.points.front().first, runs_hi = w.s.points.back().first;
+  const double tol = 0.05 * (runs_hi - runs_lo);
+  if (!(tol > 0.0)) return kNone;
+  const double past_hi = w.fit.hi95 - runs_hi, past_lo = runs_lo - w.fit.lo95;
+  if (std::max(past_hi, past_lo) <= tol) return kNone;
+  const auto [lo, hi] = fit_range(w);
+  const double x = std::clamp(past_hi >= past_lo ? w.fit.hi95 : w.fit.lo95, lo, hi);
+  // A run there must widen the span by more than the tolerance.
+  return x > runs_hi + tol || x < runs_lo - tol ? x : kNone;
 }
 
 // How each continuous candidate's chi2 at its fitted value is known. A simulated point within
