@@ -28,7 +28,7 @@ struct CalArgs {
   std::vector<std::string> models;
   std::string measurements, scale = "mini", json, report, cache = "clumpkit_cache", output;
   std::string effects;
-  int repeats = 2, threads = 0, jobs = 0, screen_repeats = 1;
+  int repeats = 2, threads = 0, jobs = 0, screen_repeats = 1, end_runs = 2;
   std::uint64_t seed = 1;
   bool apply = false, quiet = false, no_suggest = false, no_pairs = false;
   std::string suggest = "ambiguous";
@@ -238,6 +238,12 @@ Command setup_diagnose(CLI::App& parent) {
                 "phase")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
+  c->add_option("--end-runs", a->end_runs,
+                "Runs (with --repeats) at the far end of a leading candidate's 95 % interval "
+                "where it reaches past the strengths simulated for it, at most this many per "
+                "candidate; 0: none (such an interval is then only marked *)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10));
   common_options(c, *a);
   return {
       c, [a] {
@@ -260,6 +266,7 @@ Command setup_diagnose(CLI::App& parent) {
         o.scale = a->scale;
         o.repeats = a->repeats;
         o.screen_repeats = a->screen_repeats;
+        o.end_runs = a->end_runs;
         o.seed = a->seed;
         o.suggest = !a->no_suggest && a->suggest != "never";
         o.suggest_always = a->suggest == "always";
@@ -331,6 +338,7 @@ Command setup_diagnose(CLI::App& parent) {
                         {"runs_span", r.candidate.discrete || r.with ? json(nullptr)
                                                                      : json{r.runs_lo, r.runs_hi}},
                         {"interval_past_runs", r.interval_past_runs()},
+                        {"end_runs", r.end_runs},
                         {"with", r.with ? fit_json(r.with->candidate, r.with->fitted, r.with->std,
                                                    r.with->lo, r.with->hi)
                                         : json(nullptr)}});

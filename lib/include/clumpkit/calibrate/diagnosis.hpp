@@ -41,12 +41,12 @@ struct DiagnoseOptions {
   /// quarter of its uncertainty (a response far from a parabola converges in more steps); only
   /// where the baseline is inconsistent with the data (p < p_inconsistent).
   int extra_refinements = 2;
-  /// Runs (every repeat) at the far end of a leading candidate's 95 % interval where it
+  /// Runs (every repeat) at the far end of the leading candidate's 95 % interval where it
   /// reaches past the strengths simulated for it (CandidateResult::interval_past_runs), at
-  /// most this many per candidate; wherever the candidates are refined.
-  /// Past the runs the interval rests on the surrogate's straight continuation, too steep
-  /// where the response levels off. 0: none (the interval is then only marked).
-  int bracket_runs = 2;
+  /// most this many, after the ranking, wherever the candidates are refined. Past the runs
+  /// the interval rests on the surrogate's straight continuation, too steep where the
+  /// response levels off. 0: none (the interval is then only marked).
+  int end_runs = 2;
   double min_delta_bic = 6.0;  ///< "strong" evidence (Kass & Raftery)
   double p_inconsistent = 0.01;
   /// A baseline whose chi2 survival after the screen is at least this gets no refinement or
@@ -91,6 +91,9 @@ struct CandidateResult {
   /// continuation, not a run: a response that levels off past the last run (cohesion) makes
   /// that side of the interval too short. Equal when not known (discrete, pairs).
   double runs_lo = 0.0, runs_hi = 0.0;
+  /// Runs made at the far end of this (leading) candidate's interval after the ranking
+  /// (DiagnoseOptions::end_runs); they can only widen fitted_lo..fitted_hi and fitted_std.
+  int end_runs = 0;
   /// Whether the 95 % interval reaches past the simulated span by more than 5 % of it
   /// (interval_text marks it "*").
   bool interval_past_runs() const;
