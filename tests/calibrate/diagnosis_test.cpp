@@ -93,6 +93,28 @@ std::vector<Measurement> heaps_as_synth_makes_them(Simulator& sim, const Particl
   return ms;
 }
 
+// The stand-in with its cohesion law reshaped: `shape` maps the model's cohesion (J/m^3) to the
+// stand-in's linear one; runs above `limit` fail (the tube lifts the heap). 1 % seed noise per
+// run and no common random numbers, as the rigs' chaotic runs.
+struct ShapedCohesion final : Simulator {
+  explicit ShapedCohesion(std::function<double(double)> f) : shape(std::move(f)) {
+    inner.noise_rel = 0.01;
+    inner.common_random_numbers = false;
+  }
+  std::function<double(double)> shape;
+  double limit = 4e4;
+  fake::FakeSimulator inner;
+  SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
+                     std::uint64_t seed) override {
+    ParticleModel s = m;
+    const double c = m.effects.cohesion.value_or(0.0);
+    if (c > limit) throw NumericalError("heap angle: the heap is only 5 mm high: no cone");
+    if (c > 0) s.effects.cohesion = shape(c);
+    ++runs_;
+    return inner.simulate(s, r, repeats, seed);
+  }
+};
+
 }  // namespace
 
 // Seeded end-to-end test of the logic on the analytic stand-in: for each hidden effect, the
@@ -406,20 +428,6 @@ TEST(Diagnosis, AFailureAtTheRangesBoundIsNotRunAgain) {
 // points weighed by their scatter): 2 sigma 14 and 16, the 95 % interval 15 and 15 of 16; with the
 // end runs of session 47 (AnIntervalPastTheRunsGetsARunAtItsEnd) 15 and 16, 15 and 15.
 TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
-  struct Shaped final : Simulator {
-    std::function<double(double)> shape;  // cohesion -> the stand-in's (linear) cohesion
-    double limit = 4e4;                   // J/m^3: runs above fail (the tube lifts the heap)
-    fake::FakeSimulator inner;
-    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
-                       std::uint64_t seed) override {
-      ParticleModel s = m;
-      const double c = m.effects.cohesion.value_or(0.0);
-      if (c > limit) throw NumericalError("heap angle: the heap is only 5 mm high: no cone");
-      if (c > 0) s.effects.cohesion = shape(c);
-      ++runs_;
-      return inner.simulate(s, r, repeats, seed);
-    }
-  };
   const std::pair<const char*, std::function<double(double)>> shapes[] = {
       {"saturating", [](double c) { return 7.5e4 * (1.0 - std::exp(-c / 6e3)); }},
       {"accelerating", [](double c) { return 1e4 * std::expm1(c / 1e4); }},
@@ -428,10 +436,7 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
     int covered = 0, covered95 = 0, plausible = 0;
     const int trials = 16;
     for (int t = 0; t < trials; ++t) {
-      Shaped sim;
-      sim.shape = shape;
-      sim.inner.noise_rel = 0.01;
-      sim.inner.common_random_numbers = false;
+      ShapedCohesion sim(shape);
       ParticleModel base = base_model();
       set_model_effect(base, "effects.cohesion", "off", "test");
       ParticleModel truth = base;
@@ -997,19 +1002,6 @@ TEST(Diagnosis, AnIntervalPastTheRunsIsMarked) {
 // (c0 3000) a parabola cannot follow the response, so the coverage stays short of 95 %; the
 // intervals that still reach past the runs are marked "*".
 TEST(Diagnosis, AnIntervalPastTheRunsGetsARunAtItsEnd) {
-  struct Saturating final : Simulator {
-    double c0 = 6000.0;
-    fake::FakeSimulator inner;
-    SimValues simulate(const ParticleModel& m, const SimRequest& r, int repeats,
-                       std::uint64_t seed) override {
-      ParticleModel s = m;
-      const double c = m.effects.cohesion.value_or(0.0);
-      if (c > 8e4) throw NumericalError("heap angle: the heap is only 5 mm high: no cone");
-      if (c > 0) s.effects.cohesion = 7.5e4 * (1.0 - std::exp(-c / c0));
-      ++runs_;
-      return inner.simulate(s, r, repeats, seed);
-    }
-  };
   const double truth_value = 1.5e4;
   for (const double c0 : {6000.0, 3000.0}) {
     int covered[2] = {0, 0}, past[2] = {0, 0}, verdicts[2] = {0, 0};
@@ -1018,10 +1010,8 @@ TEST(Diagnosis, AnIntervalPastTheRunsGetsARunAtItsEnd) {
     std::vector<std::tuple<std::string, std::string, double, double>> ranked[2];
     for (const int with_ends : {0, 1}) {
       for (int t = 0; t < 16; ++t) {
-        Saturating sim;
-        sim.c0 = c0;
-        sim.inner.noise_rel = 0.01;
-        sim.inner.common_random_numbers = false;
+        ShapedCohesion sim([c0](double c) { return 7.5e4 * (1.0 - std::exp(-c / c0)); });
+        sim.limit = 8e4;
         ParticleModel base = base_model();
         set_model_effect(base, "effects.cohesion", "off", "test");
         ParticleModel truth = base;
