@@ -840,6 +840,7 @@ void Diagnoser::ends() {
   top.fitted_hi = w->fit.hi95;
   top.runs_lo = w->s.points.front().first;
   top.runs_hi = w->s.points.back().first;
+  top.limit = w->limit;  // an end run that failed says where the rigs stopped measuring
 }
 
 }  // namespace
