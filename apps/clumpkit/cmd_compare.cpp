@@ -239,9 +239,10 @@ Command setup_diagnose(CLI::App& parent) {
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   c->add_option("--end-runs", a->end_runs,
-                "Runs (with --repeats) at the far end of a leading candidate's 95 % interval "
-                "where it reaches past the strengths simulated for it, at most this many per "
-                "candidate; 0: none (such an interval is then only marked *)")
+                "Runs (with --repeats) at the far end of the leading candidate's 95 % "
+                "interval where it reaches past the strengths simulated for it, at most this "
+                "many, after the ranking (they can only widen the interval); 0: none (such an "
+                "interval is then only marked *)")
       ->capture_default_str()
       ->check(CLI::Range(0, 10));
   common_options(c, *a);
