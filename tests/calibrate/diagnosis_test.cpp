@@ -72,6 +72,15 @@ std::pair<ParticleModel, ParticleModel> rolling_friction_baseline_and_truth(
   return {base, truth};
 }
 
+// The paper's A12 model without cohesion as a baseline, and the same with `truth` J/m^3 of it.
+std::pair<ParticleModel, ParticleModel> cohesion_baseline_and_truth(const std::string& truth) {
+  ParticleModel base = base_model();
+  set_model_effect(base, "effects.cohesion", "off", "test");
+  ParticleModel t = base;
+  set_model_effect(t, "effects.cohesion", truth + " J/m^3", "test");
+  return {base, t};
+}
+
 // The heaps on three plates measured as `clumpkit synth` makes them: the truth's mean over 4
 // seeds plus 3 % lab noise, the stated std widened by the truth's own standard error.
 std::vector<Measurement> heaps_as_synth_makes_them(Simulator& sim, const ParticleModel& truth,
@@ -441,10 +450,7 @@ TEST(Diagnosis, ANonParabolicResponseIsFittedWhereTheFitIs) {
     const int trials = 16;
     for (int t = 0; t < trials; ++t) {
       ShapedCohesion sim(shape);
-      ParticleModel base = base_model();
-      set_model_effect(base, "effects.cohesion", "off", "test");
-      ParticleModel truth = base;
-      set_model_effect(truth, "effects.cohesion", "20000 J/m^3", "test");
+      const auto [base, truth] = cohesion_baseline_and_truth("20000");
       const auto ms = synthesize(sim, truth, 0.02, 500 + t);
       DiagnoseOptions o;
       o.suggest = false;
@@ -1016,10 +1022,7 @@ TEST(Diagnosis, AnIntervalPastTheRunsGetsARunAtItsEnd) {
       for (int t = 0; t < 16; ++t) {
         ShapedCohesion sim([c0](double c) { return 7.5e4 * (1.0 - std::exp(-c / c0)); });
         sim.limit = 8e4;
-        ParticleModel base = base_model();
-        set_model_effect(base, "effects.cohesion", "off", "test");
-        ParticleModel truth = base;
-        set_model_effect(truth, "effects.cohesion", "15000 J/m^3", "test");
+        const auto [base, truth] = cohesion_baseline_and_truth("15000");
         const auto ms = synthesize(sim, truth, 0.02, 500 + t);
         DiagnoseOptions o;
         o.suggest = false;
@@ -1068,10 +1071,7 @@ TEST(Diagnosis, AnEndRunThatFailsBoundsTheIntervalAndNamesTheLimit) {
   for (int t = 0; t < 16; ++t) {
     ShapedCohesion sim([](double c) { return 7.5e4 * (1.0 - std::exp(-c / 6000.0)); });
     sim.limit = 8e4;
-    ParticleModel base = base_model();
-    set_model_effect(base, "effects.cohesion", "off", "test");
-    ParticleModel truth = base;
-    set_model_effect(truth, "effects.cohesion", "15000 J/m^3", "test");
+    const auto [base, truth] = cohesion_baseline_and_truth("15000");
     const auto ms = synthesize(sim, truth, 0.02, 500 + t);
     sim.limit = 1.6e4;
     DiagnoseOptions o;

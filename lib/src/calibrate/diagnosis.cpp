@@ -17,6 +17,11 @@ namespace clumpkit::calibrate {
 
 namespace {
 
+// How far past the strengths simulated for a candidate its 95 % interval may reach, as a share
+// of their span, before it counts as resting on the surrogate's straight continuation (a little
+// past the runs is the tangent's job: a 95 % end a hair beyond a bound run).
+constexpr double kPastRunsTolerance = 0.05;
+
 std::string observable_name(const Measurement& m) {
   const std::string s = m.setting_text();
   return fmt::format("{} {}{} {}", m.rig, m.sample, s.empty() ? "" : " [" + s + "]", m.quantity);
@@ -451,7 +456,7 @@ double Diagnoser::far_end(const Work& w) const {
   constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
   if (w.c.discrete || w.s.points.size() < 2) return kNone;
   const double runs_lo = w.s.points.front().first, runs_hi = w.s.points.back().first;
-  const double tol = 0.05 * (runs_hi - runs_lo);
+  const double tol = kPastRunsTolerance * (runs_hi - runs_lo);
   if (!(tol > 0.0)) return kNone;
   const double past_hi = w.fit.hi95 - runs_hi, past_lo = runs_lo - w.fit.lo95;
   if (std::max(past_hi, past_lo) <= tol) return kNone;
@@ -847,8 +852,7 @@ void Diagnoser::ends() {
 
 bool CandidateResult::interval_past_runs() const {
   if (candidate.discrete || with || !(runs_hi > runs_lo)) return false;
-  // A little past the runs is the tangent's job (a 95 % end a hair beyond a bound run).
-  const double tol = 0.05 * (runs_hi - runs_lo);
+  const double tol = kPastRunsTolerance * (runs_hi - runs_lo);
   return fitted_lo < runs_lo - tol || fitted_hi > runs_hi + tol;
 }
 
