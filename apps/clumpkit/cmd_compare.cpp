@@ -49,8 +49,8 @@ void common_options(CLI::App* c, CalArgs& a) {
       ->capture_default_str();
   c->add_option("--threads", a.threads, "Engine threads per rig run (0 = the engine's choice)");
   c->add_option("--jobs", a.jobs,
-                "Rig runs made side by side, one engine thread each (0 = one per core at the "
-                "tiny and mini scales, 1 at small and paper)")
+                "Rig runs made side by side, each repeat apart, one engine thread each (0 = one "
+                "per core at the tiny and mini scales, 1 at small and paper)")
       ->check(CLI::Range(0, 256));
   c->add_option("--engine", a.engine,
                 "clumpkit (the bundled runner) | liggghts: every rig run written as a LIGGGHTS "

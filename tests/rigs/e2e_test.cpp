@@ -266,5 +266,21 @@ TEST(RigEndToEnd, ScaleThatCannotHoldTheMassIsRefused) {
   EXPECT_THROW(run_rig(request("angle_of_repose", "scale=mini;mass=2", "e2e_refused")), InputError);
 }
 
+// A request for one repeat (only_repeat) names a repeat the request has, before any run.
+TEST(RigEndToEnd, OnlyARepeatOfTheRequestIsMade) {
+  for (int k : {-1, 3}) {
+    RigRequest r = request("bulk_density", "scale=tiny", "e2e_only_repeat");
+    r.repeats = 2;
+    r.only_repeat = k;
+    try {
+      run_rig(r);
+      ADD_FAILURE() << "only_repeat " << k << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("only_repeat"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(r.out / "repeat_1")) << "nothing is run";
+  }
+}
+
 }  // namespace
 }  // namespace clumpkit::rigs

@@ -136,10 +136,14 @@ class Diagnoser {
       pool.add(v);
     return v;
   }
-  void prefetch(const std::vector<ParticleModel>& models, int repeats) {
+  // Runs the models' rig runs side by side (`repeats` each, or a model's own where it states
+  // them), the first time each is needed; a run that fails is left to simulate().
+  void prefetch(const std::vector<ParticleModel>& models, int repeats,
+                const std::vector<int>& own_repeats = {}) {
     std::vector<SimJob> jobs;
-    for (const auto& m : models)
-      for (const auto& r : requests) jobs.push_back({m, r});
+    for (size_t i = 0; i < models.size(); ++i)
+      for (const auto& r : requests)
+        jobs.push_back({models[i], r, i < own_repeats.size() ? own_repeats[i] : repeats});
     try {
       sim.prefetch(jobs, repeats, o.seed);
     } catch (const NumericalError&) {
@@ -249,14 +253,9 @@ void Diagnoser::screen() {
         fmt::format("{} model variants to simulate first: the baseline ({} repeats), probes and "
                     "levels ({} repeat{} each)",
                     first.size() + 1, o.repeats, screen_n, screen_n == 1 ? "" : "s"));
-    // The baseline's runs, then the screen's, each set side by side.
-    if (screen_n == o.repeats) {
-      first.insert(first.begin(), base);
-      prefetch(first, o.repeats);
-    } else {
-      prefetch({base}, o.repeats);
-      prefetch(first, screen_n);
-    }
+    // The baseline's runs and the screen's, all side by side.
+    first.insert(first.begin(), base);
+    prefetch(first, screen_n, {o.repeats});
   }
   say("baseline model " + base.name);
   s0 = simulate(base, o.repeats);

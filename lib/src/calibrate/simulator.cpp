@@ -143,8 +143,22 @@ std::optional<Cached> read_cached(const fs::path& file, const std::string& key) 
 }
 }  // namespace
 
-SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, std::uint64_t seed,
-                            int threads) {
+void RigSimulator::announce(const Entry& e, const SimRequest& req, int repeats) {
+  if (!opt_.progress) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  // The run's number and the time since this simulator began: a diagnosis's only clock.
+  const double minutes =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count() / 60.0;
+  opt_.progress(fmt::format(
+      "[rig run {}, {:.1f} min] simulating {} sample {} [{}] model {} x{}{}", ++started_, minutes,
+      req.rig, req.sample, format_settings(req.settings), e.model.name, repeats,
+      opt_.engine == "clumpkit"
+          ? ""
+          : fmt::format(" on {} ({} MPI rank(s))", opt_.engine, std::max(1, opt_.liggghts_ranks))));
+}
+
+rigs::RigResult RigSimulator::launch(const Entry& e, const SimRequest& req, int repeats,
+                                     std::uint64_t seed, int threads, int only_repeat) {
   std::error_code ec;
   fs::create_directories(opt_.cache_dir, ec);
   rigs::RigRequest rr;
@@ -152,6 +166,7 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
   rr.model = e.model;
   rr.settings = req.settings;
   rr.repeats = repeats;
+  rr.only_repeat = only_repeat;
   rr.seed = seed;
   rr.threads = threads;
   rr.rays = opt_.rays;
@@ -164,19 +179,10 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
       std::lock_guard<std::mutex> lock(mutex_);
       opt_.progress(s);
     };
-  if (opt_.progress) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    // The run's number and the time since this simulator began: a diagnosis's only clock.
-    const double minutes =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count() / 60.0;
-    opt_.progress(fmt::format(
-        "[rig run {}, {:.1f} min] simulating {} sample {} [{}] model {} x{}{}", ++started_, minutes,
-        req.rig, req.sample, format_settings(req.settings), e.model.name, repeats,
-        opt_.engine == "clumpkit" ? ""
-                                  : fmt::format(" on {} ({} MPI rank(s))", opt_.engine,
-                                                std::max(1, opt_.liggghts_ranks))));
-  }
-  const rigs::RigResult r = rigs::run_rig(rr);
+  return rigs::run_rig(rr);
+}
+
+SimValues RigSimulator::keep(const Entry& e, const SimRequest& req, const rigs::RigResult& r) {
   // The entry keeps the run's values, or why the rigs could not measure (thrown again when asked).
   json entry = {{"key", e.key}, {"result", r.to_json()}};
   SimValues v;
@@ -208,6 +214,12 @@ SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, 
   return v;
 }
 
+SimValues RigSimulator::run(const Entry& e, const SimRequest& req, int repeats, std::uint64_t seed,
+                            int threads) {
+  announce(e, req, repeats);
+  return keep(e, req, launch(e, req, repeats, seed, threads, 0));
+}
+
 SimValues RigSimulator::simulate(const ParticleModel& model, const SimRequest& req, int repeats,
                                  std::uint64_t seed) {
   const Entry e = entry(model, req, repeats, seed);
@@ -227,35 +239,67 @@ void RigSimulator::prefetch(const std::vector<SimJob>& jobs, int repeats, std::u
   struct Pending {
     Entry e;
     SimRequest req;
+    int repeats;
+    // The run of the lowest repeat that failed, if one did: a job run whole stops there.
+    int failed_repeat = 0;
+    rigs::RigResult failed;
   };
   std::vector<Pending> todo;
   std::set<fs::path> seen;
   for (const SimJob& j : jobs) {
-    Entry e = entry(j.model, j.request, repeats, seed);
+    const int n = j.repeats > 0 ? j.repeats : repeats;
+    Entry e = entry(j.model, j.request, n, seed);
     if (!seen.insert(e.file).second || read_cached(e.file, e.key)) continue;
-    todo.push_back({std::move(e), j.request});
+    todo.push_back({std::move(e), j.request, n, 0, {}});
   }
-  if (todo.size() < 2) return;
-  // A failed job does not stop the others (the caller makes it again where it is needed, and
-  // its rig folder keeps the failed repeat's last checkpoint, so that re-run is short); the
-  // first error is rethrown once all are done.
+  // Each repeat of each job is a task (job, repeat): a batch of three jobs of two repeats on two
+  // cores no longer ends with one job's two repeats run one after the other on one core while
+  // the other waits. A repeat's result depends on its seed only (the same bits on any thread
+  // count), and each writes its own repeat_K/ of the job's folder, where the job, run whole
+  // below, keeps it.
+  std::vector<std::pair<size_t, int>> tasks;
+  for (size_t i = 0; i < todo.size(); ++i)
+    for (int k = 1; k <= todo[i].repeats; ++k) tasks.emplace_back(i, k);
+  if (tasks.size() < 2) return;
+  // A failed task does not stop the others; the first error that is not the rigs' failing to
+  // measure is rethrown once all are done.
   std::atomic<size_t> next{0};
   std::exception_ptr first_error;
   auto worker = [&] {
-    for (size_t i; (i = next++) < todo.size();) {
+    for (size_t t; (t = next++) < tasks.size();) {
+      Pending& p = todo[tasks[t].first];
+      const int k = tasks[t].second;
       try {
-        run(todo[i].e, todo[i].req, repeats, seed, 1);
+        if (k == 1) announce(p.e, p.req, p.repeats);
+        rigs::RigResult r = launch(p.e, p.req, p.repeats, seed, 1, k);
+        if (!r.error.empty()) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          if (p.failed_repeat == 0 || k < p.failed_repeat) {
+            p.failed_repeat = k;
+            p.failed = std::move(r);
+          }
+        }
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex_);
         if (!first_error) first_error = std::current_exception();
       }
     }
   };
-  const size_t workers = std::min<size_t>(static_cast<size_t>(opt_.jobs), todo.size());
+  const size_t workers = std::min<size_t>(static_cast<size_t>(opt_.jobs), tasks.size());
   std::vector<std::thread> pool;
   for (size_t w = 1; w < workers; ++w) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
+  if (first_error) std::rethrow_exception(first_error);
+  // Each job whole: its repeats are kept from their folders (nothing is simulated again), or
+  // its lowest failed repeat is its failure, as when the job runs its repeats in order.
+  for (Pending& p : todo) {
+    try {
+      keep(p.e, p.req, p.failed_repeat > 0 ? p.failed : launch(p.e, p.req, p.repeats, seed, 1, 0));
+    } catch (const NumericalError&) {
+      if (!first_error) first_error = std::current_exception();
+    }
+  }
   if (first_error) std::rethrow_exception(first_error);
 }
 

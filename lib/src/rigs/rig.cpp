@@ -267,6 +267,9 @@ RigResult run_rig(const RigRequest& req) {
   if (req.adjust) req.adjust(res.params);
   res.scale = res.params.name;
   check_engine(req.engine, req.liggghts_ranks);
+  if (req.only_repeat < 0 || req.only_repeat > req.repeats)
+    throw InputError("rig request", "only_repeat",
+                     fmt::format("{} is not a repeat of 1 … {}", req.only_repeat, req.repeats));
   if (req.engine == "liggghts" && !req.bed_from.empty())
     throw InputError("--bed-from", req.bed_from.string(), "not with --engine liggghts");
   // A folder holds one engine's repeats: mixing them would average two codes.
@@ -291,7 +294,9 @@ RigResult run_rig(const RigRequest& req) {
   if (req.progress) req.progress("building clump templates: " + req.model.summary());
   proto.types = req.model.clump_types(req.rays);
   if (!req.out.empty()) fs::create_directories(req.out);
-  for (int k = 0; k < req.repeats; ++k) {
+  const int first = req.only_repeat > 0 ? req.only_repeat - 1 : 0;
+  const int last = req.only_repeat > 0 ? req.only_repeat : req.repeats;
+  for (int k = first; k < last; ++k) {
     Ctx c{req, res.params, proto.types, {}, req.seed + std::uint64_t(k), k};
     if (!req.out.empty()) {
       c.dir = req.out / fmt::format("repeat_{}", k + 1);

@@ -16,6 +16,7 @@
 #include "clumpkit/calibrate/comparison.hpp"
 #include "clumpkit/calibrate/measurements.hpp"
 #include "clumpkit/rigs/model.hpp"
+#include "clumpkit/rigs/rig.hpp"
 
 namespace clumpkit::calibrate {
 
@@ -36,6 +37,7 @@ using SimValues = std::map<std::string, SimulatedValue>;
 struct SimJob {
   ParticleModel model;
   SimRequest request;
+  int repeats = 0;  ///< this job's repeats; 0 = those the prefetch() call gives
 };
 
 class Simulator {
@@ -92,8 +94,10 @@ class RigSimulator final : public Simulator {
   explicit RigSimulator(Options options);
   SimValues simulate(const ParticleModel& model, const SimRequest& request, int repeats,
                      std::uint64_t seed) override;
-  /// Runs the jobs not yet in the cache, `Options::jobs` at a time; the first failure is
-  /// rethrown after the running ones finish (no new ones start).
+  /// Runs the jobs not yet in the cache, `Options::jobs` repeats at a time: each repeat of each
+  /// job is a task of its own (one engine thread), so the cores stay busy to the end of the
+  /// batch. Results are those of the jobs run one by one. The first failure is rethrown once
+  /// every task has finished.
   void prefetch(const std::vector<SimJob>& jobs, int repeats, std::uint64_t seed) override;
   /// Requests served from results this simulator did not make itself (an earlier process's;
   /// not what its own prefetch() ran a moment before).
@@ -111,6 +115,12 @@ class RigSimulator final : public Simulator {
               std::uint64_t seed) const;
   SimValues run(const Entry& e, const SimRequest& request, int repeats, std::uint64_t seed,
                 int threads);
+  /// The rig run of an entry: every repeat (only_repeat 0), or that one alone.
+  rigs::RigResult launch(const Entry& e, const SimRequest& request, int repeats, std::uint64_t seed,
+                         int threads, int only_repeat);
+  /// Keeps a finished run as the entry's cache file; throws NumericalError if it failed.
+  SimValues keep(const Entry& e, const SimRequest& request, const rigs::RigResult& r);
+  void announce(const Entry& e, const SimRequest& request, int repeats);
 
   Options opt_;
   long hits_ = 0;

@@ -92,7 +92,11 @@ struct RigRequest {
   ParticleModel model;
   std::map<std::string, std::string> settings;  ///< parsed by parse_settings (scale included)
   int repeats = 1;
-  std::uint64_t seed = 1;             ///< repeat k uses seed + k
+  std::uint64_t seed = 1;  ///< repeat k uses seed + k
+  /// 1 … repeats: make (or keep from `out`) that repeat alone, as the whole request would make
+  /// it; 0 = every repeat. A caller runs the repeats of one request side by side this way, each
+  /// into the same `out`, and a last call with 0 then keeps them all (the calibration's cache).
+  int only_repeat = 0;
   std::filesystem::path out;          ///< checkpoints, per-repeat results, pictures; empty = none
   bool vtk = false;                   ///< write VTK (.vtp) snapshots for ParaView into `out`
   int threads = 0;                    ///< 0 = all
