@@ -158,7 +158,7 @@ void RigSimulator::announce(const Entry& e, const SimRequest& req, int repeats) 
 }
 
 rigs::RigResult RigSimulator::launch(const Entry& e, const SimRequest& req, int repeats,
-                                     std::uint64_t seed, int threads, int only_repeat) {
+                                     std::uint64_t seed, int threads, int only_repeat, bool quiet) {
   std::error_code ec;
   fs::create_directories(opt_.cache_dir, ec);
   rigs::RigRequest rr;
@@ -174,7 +174,7 @@ rigs::RigResult RigSimulator::launch(const Entry& e, const SimRequest& req, int 
   rr.keep_bed = false;  // nothing turns a cached run's discharger bed again
   rr.engine = opt_.engine;
   rr.liggghts_ranks = opt_.liggghts_ranks;
-  if (opt_.progress)
+  if (opt_.progress && !quiet)
     rr.progress = [this](const std::string& s) {
       std::lock_guard<std::mutex> lock(mutex_);
       opt_.progress(s);
@@ -295,7 +295,8 @@ void RigSimulator::prefetch(const std::vector<SimJob>& jobs, int repeats, std::u
   // its lowest failed repeat is its failure, as when the job runs its repeats in order.
   for (Pending& p : todo) {
     try {
-      keep(p.e, p.req, p.failed_repeat > 0 ? p.failed : launch(p.e, p.req, p.repeats, seed, 1, 0));
+      keep(p.e, p.req,
+           p.failed_repeat > 0 ? p.failed : launch(p.e, p.req, p.repeats, seed, 1, 0, true));
     } catch (const NumericalError&) {
       if (!first_error) first_error = std::current_exception();
     }

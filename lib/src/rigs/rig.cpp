@@ -291,7 +291,9 @@ RigResult run_rig(const RigRequest& req) {
                                    k + 1, engine, req.engine));
   }
   Ctx proto{req, res.params, {}, {}, 1, 0};
-  if (req.progress) req.progress("building clump templates: " + req.model.summary());
+  // Said once per request: by its whole run, or by its first repeat run alone.
+  if (req.progress && req.only_repeat <= 1)
+    req.progress("building clump templates: " + req.model.summary());
   proto.types = req.model.clump_types(req.rays);
   if (!req.out.empty()) fs::create_directories(req.out);
   const int first = req.only_repeat > 0 ? req.only_repeat - 1 : 0;

@@ -115,9 +115,10 @@ class RigSimulator final : public Simulator {
               std::uint64_t seed) const;
   SimValues run(const Entry& e, const SimRequest& request, int repeats, std::uint64_t seed,
                 int threads);
-  /// The rig run of an entry: every repeat (only_repeat 0), or that one alone.
+  /// The rig run of an entry: every repeat (only_repeat 0), or that one alone; `quiet`: no
+  /// progress lines (a run whose repeats are all kept from their folders).
   rigs::RigResult launch(const Entry& e, const SimRequest& request, int repeats, std::uint64_t seed,
-                         int threads, int only_repeat);
+                         int threads, int only_repeat, bool quiet = false);
   /// Keeps a finished run as the entry's cache file; throws NumericalError if it failed.
   SimValues keep(const Entry& e, const SimRequest& request, const rigs::RigResult& r);
   void announce(const Entry& e, const SimRequest& request, int repeats);
