@@ -261,8 +261,8 @@ void RigSimulator::prefetch(const std::vector<SimJob>& jobs, int repeats, std::u
   for (size_t i = 0; i < todo.size(); ++i)
     for (int k = 1; k <= todo[i].repeats; ++k) tasks.emplace_back(i, k);
   if (tasks.size() < 2) return;
-  // A failed task does not stop the others; the first error that is not the rigs' failing to
-  // measure is rethrown once all are done.
+  // A task that fails does not stop the others. A repeat the rigs cannot measure is kept as its
+  // job's failure (below); any other error is rethrown once every task has finished.
   std::atomic<size_t> next{0};
   std::exception_ptr first_error;
   auto worker = [&] {
@@ -292,7 +292,8 @@ void RigSimulator::prefetch(const std::vector<SimJob>& jobs, int repeats, std::u
   for (auto& t : pool) t.join();
   if (first_error) std::rethrow_exception(first_error);
   // Each job whole: its repeats are kept from their folders (nothing is simulated again), or
-  // its lowest failed repeat is its failure, as when the job runs its repeats in order.
+  // its lowest failed repeat is its failure, as when the job runs its repeats in order (the
+  // first such failure is rethrown once every job's entry is written).
   for (Pending& p : todo) {
     try {
       keep(p.e, p.req,
