@@ -3,12 +3,14 @@
 
     python3 bench/cache_utilisation.py CACHE_DIR [--cores 2]
 
-Each cached rig result (CACHE_DIR/*.json, written by `clumpkit compare|diagnose|synth --cache`)
-holds its repeats' wall seconds; the file's modification time is when the job ended. From these
-the jobs' spans are rebuilt and the script prints the number of jobs and repeats, the span from
-the first start to the last end, the busy seconds, the utilisation (busy / (cores x span)), the
-time with only one job running and with none, and the mean wall time per repeat by rig. Copying
-the folder without keeping modification times (cp -p, rsync -t) makes the figures meaningless."""
+Each rig run of the cache keeps its repeats in CACHE_DIR/run_<rig>_<id>/repeat_K/result.json
+(written by `clumpkit compare|diagnose|synth --cache`), each with its wall seconds; the file's
+modification time is when the repeat ended. From these the repeats' spans are rebuilt (since
+session 48 the repeats of one run may run at the same time, so spans are per repeat, not per
+run) and the script prints the number of runs and repeats, the span from the first start to
+the last end, the busy seconds, the utilisation (busy / (cores x span)), the time with only one
+repeat running and with none, and the mean wall time per repeat by rig. Copying the folder
+without keeping modification times (cp -p, rsync -t) makes the figures meaningless."""
 import argparse
 import collections
 import glob
@@ -22,18 +24,18 @@ def main():
     ap.add_argument("cache")
     ap.add_argument("--cores", type=int, default=2)
     a = ap.parse_args()
-    jobs = []
-    for f in sorted(glob.glob(os.path.join(a.cache, "*.json"))):
+    runs = glob.glob(os.path.join(a.cache, "*.json"))
+    jobs = []  # one per repeat: (start, end, wall, rig)
+    for f in sorted(glob.glob(os.path.join(a.cache, "run_*", "repeat_*", "result.json"))):
         try:
-            result = json.load(open(f))["result"]
+            wall = float(json.load(open(f))["wall_seconds"])
         except (OSError, ValueError, KeyError) as e:
-            sys.exit(f"{f}: not a clumpkit cache entry ({e})")
-        wall = sum(r.get("wall_seconds", 0.0) for r in result["repeats"])
+            sys.exit(f"{f}: not a clumpkit repeat result ({e})")
         end = os.path.getmtime(f)
-        rig = os.path.basename(f).rsplit("_", 1)[0]
-        jobs.append((end - wall, end, wall, rig, len(result["repeats"])))
+        rig = os.path.basename(os.path.dirname(os.path.dirname(f)))[4:].rsplit("_", 1)[0]
+        jobs.append((end - wall, end, wall, rig))
     if not jobs:
-        sys.exit(f"{a.cache}: no cached rig results (*.json)")
+        sys.exit(f"{a.cache}: no repeats of cached rig runs (run_*/repeat_*/result.json)")
     start = min(j[0] for j in jobs)
     stop = max(j[1] for j in jobs)
     busy = sum(j[2] for j in jobs)
@@ -47,14 +49,14 @@ def main():
         running += d
         last = t
     span = stop - start
-    print(f"{len(jobs)} jobs, {sum(j[4] for j in jobs)} repeats, span {span:.0f} s, "
+    print(f"{len(runs)} runs, {len(jobs)} repeats, span {span:.0f} s, "
           f"busy {busy:.0f} s, utilisation {busy / (a.cores * span):.2f}")
-    print(f"one job running {one:.0f} s, none {none:.0f} s")
+    print(f"one repeat running {one:.0f} s, none {none:.0f} s")
     per = collections.defaultdict(list)
     for j in jobs:
-        per[j[3]].append(j[2] / j[4])
+        per[j[3]].append(j[2])
     for rig, v in sorted(per.items()):
-        print(f"{rig}: {len(v)} jobs, {sum(v) / len(v):.1f} s per repeat")
+        print(f"{rig}: {len(v)} repeats, {sum(v) / len(v):.1f} s per repeat")
 
 
 if __name__ == "__main__":
