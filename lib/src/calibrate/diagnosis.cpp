@@ -136,16 +136,18 @@ class Diagnoser {
       pool.add(v);
     return v;
   }
-  // Runs the models' rig runs side by side (`repeats` each, or a model's own where it states
-  // them), the first time each is needed; a run that fails is left to simulate().
-  void prefetch(const std::vector<ParticleModel>& models, int repeats,
-                const std::vector<int>& own_repeats = {}) {
+  // The rig runs of the models, `repeats` each.
+  std::vector<SimJob> jobs_of(const std::vector<ParticleModel>& models, int repeats) const {
     std::vector<SimJob> jobs;
-    for (size_t i = 0; i < models.size(); ++i)
-      for (const auto& r : requests)
-        jobs.push_back({models[i], r, i < own_repeats.size() ? own_repeats[i] : repeats});
+    for (const auto& m : models)
+      for (const auto& r : requests) jobs.push_back({m, r, repeats});
+    return jobs;
+  }
+  // Runs the jobs side by side the first time each is needed; a run that fails is left to
+  // simulate().
+  void prefetch(const std::vector<SimJob>& jobs) {
     try {
-      sim.prefetch(jobs, repeats, o.seed);
+      sim.prefetch(jobs, o.repeats, o.seed);
     } catch (const NumericalError&) {
       // The failing run is made again where it is needed, and handled there.
     }
@@ -254,8 +256,9 @@ void Diagnoser::screen() {
                     "levels ({} repeat{} each)",
                     first.size() + 1, o.repeats, screen_n, screen_n == 1 ? "" : "s"));
     // The baseline's runs and the screen's, all side by side.
-    first.insert(first.begin(), base);
-    prefetch(first, screen_n, {o.repeats});
+    std::vector<SimJob> jobs = jobs_of({base}, o.repeats);
+    for (SimJob& j : jobs_of(first, screen_n)) jobs.push_back(std::move(j));
+    prefetch(jobs);
   }
   say("baseline model " + base.name);
   s0 = simulate(base, o.repeats);
@@ -329,7 +332,7 @@ void Diagnoser::screen() {
 void Diagnoser::screen_more(const std::vector<std::pair<Work*, double>>& runs, const char* where) {
   std::vector<ParticleModel> models;
   for (const auto& [w, v] : runs) models.push_back(w->c.apply(base, v));
-  prefetch(models, screen_n);
+  prefetch(jobs_of(models, screen_n));
   for (const auto& [w, v] : runs) {
     say(fmt::format("{}: sensitivity {}, at {} = {}", w->c.effect, where, w->c.parameter,
                     w->c.format(v)));
@@ -408,7 +411,7 @@ void Diagnoser::refine() {
   while (!refining.empty()) {
     std::vector<ParticleModel> models;
     for (Work* w : refining) models.push_back(w->c.apply(base, w->fit.theta));
-    prefetch(models, o.repeats);
+    prefetch(jobs_of(models, o.repeats));
     std::vector<Work*> still;
     for (Work* w : refining) {
       say(fmt::format("{}: refining at {}", w->c.effect, w->c.format(w->fit.theta)));
@@ -529,7 +532,7 @@ void Diagnoser::confirm() {
   {  // the confirmation runs, side by side
     std::vector<ParticleModel> models;
     for (const auto& [w, value] : confirm) models.push_back(w->c.apply(base, value));
-    prefetch(models, o.repeats);
+    prefetch(jobs_of(models, o.repeats));
   }
   for (const auto& [w, value] : confirm) {
     say(fmt::format("{}: confirming at {}", w->c.effect, w->c.format(value)));
@@ -656,7 +659,7 @@ void Diagnoser::fit_pairs() {
   for (int run = 0; run < o.pair_runs && !going.empty(); ++run) {
     std::vector<ParticleModel> models;
     for (PairWork* p : going) models.push_back(model_of(*p));
-    prefetch(models, o.repeats);
+    prefetch(jobs_of(models, o.repeats));
     std::vector<PairWork*> still;
     for (PairWork* p : going) {
       say(fmt::format("{} + {}: confirming at {} and {}", p->a->c.effect, p->b->c.effect,

@@ -290,19 +290,16 @@ RigResult run_rig(const RigRequest& req) {
                                    "{}: give another --out",
                                    k + 1, engine, req.engine));
   }
-  Ctx proto{req, res.params, {}, {}, 1, 0};
-  // Said once per request: by its whole run, or by its first repeat run alone.
-  if (req.progress && req.only_repeat <= 1)
-    req.progress("building clump templates: " + req.model.summary());
-  proto.types = req.model.clump_types(req.rays);
-  if (!req.out.empty()) fs::create_directories(req.out);
+  // The clump templates are built before the first repeat that runs, and not at all where every
+  // repeat is kept from `out` (a run made whole from repeats run alone); folders are made after
+  // them, so a model whose templates cannot be built leaves none.
+  std::optional<std::vector<dem::ClumpTypeSettings>> types;
   const int first = req.only_repeat > 0 ? req.only_repeat - 1 : 0;
   const int last = req.only_repeat > 0 ? req.only_repeat : req.repeats;
   for (int k = first; k < last; ++k) {
-    Ctx c{req, res.params, proto.types, {}, req.seed + std::uint64_t(k), k};
+    Ctx c{req, res.params, {}, {}, req.seed + std::uint64_t(k), k};
     if (!req.out.empty()) {
       c.dir = req.out / fmt::format("repeat_{}", k + 1);
-      fs::create_directories(c.dir);
       const fs::path done = c.dir / "result.json";
       if (path_exists(done)) {
         const auto j = nlohmann::json::parse(read_file(done));
@@ -320,6 +317,14 @@ RigResult run_rig(const RigRequest& req) {
         }
       }
     }
+    if (!types) {
+      // Said once per request: by its whole run, or by its first repeat run alone.
+      if (req.progress && req.only_repeat <= 1)
+        req.progress("building clump templates: " + req.model.summary());
+      types = req.model.clump_types(req.rays);
+    }
+    c.types = *types;
+    if (!c.dir.empty()) fs::create_directories(c.dir);
     const auto t_start = Clock::now();
     RepeatResult r;
     try {
