@@ -279,6 +279,59 @@ void World::Impl::rebuild_neighbours() {
   refresh_wall_active();
 }
 
+bool World::Impl::pair_list_complete(double d1) const {
+  // The last rebuild's bins: (cell key, sphere) of every sphere where it was then, sorted.
+  const int ns = static_cast<int>(s_r.size());
+  const int nc = static_cast<int>(c_first.size());
+  const std::vector<std::pair<std::uint64_t, int>>& bins = scratch_bins;
+  // No bins of the current spheres (a checkpoint was just loaded), or cells too small for the
+  // search below: rebuild.
+  if (static_cast<int>(bins.size()) != ns || static_cast<int>(c_disp2.size()) != nc ||
+      cell < 2.0 * r_max + skin || d1 > skin)
+    return false;
+  // A pair missing from the list was at least r_i + r_j + skin apart at the rebuild, so it
+  // touches now only if its clumps moved more than the skin together: one of them more than
+  // half. Those clumps' spheres are searched against all.
+  const double half2 = 0.25 * skin * skin;
+  int fast_spheres = 0;
+  for (int c = 0; c < nc; ++c)
+    if (c_disp2[c] > half2) fast_spheres += sphere_end(c) - c_first[c];
+  // Searching costs about what rebuilding does once a quarter of the spheres are searched.
+  if (fast_spheres > ns / 4 + 8) return false;
+  const double h = cell;
+  for (int c = 0; c < nc; ++c) {
+    if (c_disp2[c] <= half2) continue;
+    const double dc = std::sqrt(c_disp2[c]);
+    for (int i = c_first[c]; i < sphere_end(c); ++i) {
+      // A sphere j touching i now was within r_i + r_j + d1 <= 2 r_max + skin = one cell of
+      // where i is now when the bins were made (it moved at most d1 <= skin since): the 27
+      // cells around i's current cell hold it.
+      const Eigen::Vector3d& p = s_pos[i];
+      const std::int64_t x = cell_of(p.x(), h), y = cell_of(p.y(), h), z = cell_of(p.z(), h);
+      for (std::int64_t dx = -1; dx <= 1; ++dx)
+        for (std::int64_t dy = -1; dy <= 1; ++dy) {
+          const std::uint64_t last = cell_key(x + dx, y + dy, z + 1);
+          for (auto it = std::lower_bound(bins.begin(), bins.end(),
+                                          std::make_pair(cell_key(x + dx, y + dy, z - 1), -1));
+               it != bins.end() && it->first <= last; ++it) {
+            const int j = it->second;
+            const int cj = s_clump[j];
+            if (cj == c || dc + std::sqrt(c_disp2[cj]) <= skin) continue;
+            const double rr = s_r[i] + s_r[j];
+            if ((s_pos[i] - s_pos[j]).squaredNorm() >= rr * rr) continue;
+            const PairEntry key{std::min(i, j), std::max(i, j)};
+            const auto at = std::lower_bound(pairs.begin(), pairs.end(), key,
+                                             [](const PairEntry& a, const PairEntry& b) {
+                                               return a.i < b.i || (a.i == b.i && a.j < b.j);
+                                             });
+            if (at == pairs.end() || at->i != key.i || at->j != key.j) return false;
+          }
+        }
+    }
+  }
+  return true;
+}
+
 void World::Impl::refresh_wall_active() {
   const int ns = static_cast<int>(s_r.size());
   wall_active.clear();

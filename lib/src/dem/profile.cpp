@@ -23,7 +23,8 @@ std::string Profile::table() const {
   row("output", output);
   row("total", tot);
   char buf[96];
-  std::snprintf(buf, sizeof buf, "steps %ld, neighbour rebuilds %ld\n", steps, neighbour_rebuilds);
+  std::snprintf(buf, sizeof buf, "steps %ld, neighbour rebuilds %ld (%ld spared)\n", steps,
+                neighbour_rebuilds, neighbour_rebuilds_spared);
   s += buf;
   if (implicit_clump_steps > 0) {
     std::snprintf(

@@ -182,6 +182,7 @@ void World::Impl::kick_and_drift() {
   const int ns = static_cast<int>(s_r.size());
   const double h = 0.5 * dt;
   TopTwo top;
+  c_disp2.resize(nc);
   // Two loops over the clumps in one parallel region: the first kicks and turns each clump,
   // the second moves its spheres. Apart, the first loop's iterations are short enough for the
   // processor to overlap the dependent sincos chains of neighbouring clumps. Both loops share
@@ -223,6 +224,7 @@ void World::Impl::kick_and_drift() {
         s_pos[s] = p;
         dc = std::max(dc, (p - s_pos_build[s]).squaredNorm());
       }
+      c_disp2[c] = dc;
       mine.add(dc);
     }
     // The two largest of a set do not depend on the order it is merged in.
@@ -268,10 +270,12 @@ void World::Impl::update_neighbours() {
     top = drift_disp2;  // measured by kick_and_drift; spheres added since have not moved
   } else {
     const int nc = static_cast<int>(c_first.size());
+    c_disp2.resize(nc);
     for (int c = 0; c < nc; ++c) {
       double dc = 0.0;
       for (int s = c_first[c]; s < sphere_end(c); ++s)
         dc = std::max(dc, (s_pos[s] - s_pos_build[s]).squaredNorm());
+      c_disp2[c] = dc;
       top.add(dc);
     }
   }
@@ -285,7 +289,16 @@ void World::Impl::update_neighbours() {
     for (size_t k = 0; k < wd.vertices.size(); ++k)
       dw = std::max(dw, (wd.vertices[k] - wd.vertices_build[k]).squaredNorm());
   dw = std::sqrt(dw);
-  if (need_rebuild || d1 + d2 > skin || d1 + dw > skin) {
+  // The displacement bound is a worst case: the two clumps that moved most may be far apart.
+  // Where only it fires, the last rebuild's cells are searched for a touching pair the list
+  // lacks; the list is rebuilt only if one is found. A pair touching or not, the contacts and
+  // forces are the same (the list is a superset cache), so the trajectory keeps its bits.
+  bool rebuild = need_rebuild || d1 + dw > skin;
+  if (!rebuild && d1 + d2 > skin) {
+    rebuild = !settings.neighbour_search || !pair_list_complete(d1);
+    if (!rebuild) ++profile.neighbour_rebuilds_spared;
+  }
+  if (rebuild) {
     rebuild_neighbours();
     ++profile.neighbour_rebuilds;
   }

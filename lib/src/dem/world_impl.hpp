@@ -183,6 +183,9 @@ struct World::Impl {
   };
   TopTwo drift_disp2;
   bool drift_disp_valid = false;
+  // Per clump, its spheres' largest squared displacement since the rebuild (m^2), beside
+  // drift_disp2 (valid with it): pair_list_complete reads which clumps moved far.
+  std::vector<double> c_disp2;
   double skin = 0.0, cell = 0.0, r_max = 0.0, r_min = 0.0;
 
   // Contacts of the current step.
@@ -278,6 +281,7 @@ struct World::Impl {
   double kinetic_energy() const;
   double potential_energy() const;
   void rebuild_neighbours();
+  bool pair_list_complete(double d1) const;
   void refresh_wall_active();
   std::uint64_t compute_fingerprint() const;
 };

@@ -15,6 +15,9 @@ struct Profile {
   double output = 0.0;      ///< s, filled in by callers that write files
   long steps = 0;
   long neighbour_rebuilds = 0;
+  /// Steps at which the displacement bound called for a rebuild and a search of the last
+  /// rebuild's cells found every touching pair already listed (no rebuild made).
+  long neighbour_rebuilds_spared = 0;
   /// Implicit damping (WorldSettings::implicit_damping): clump-steps in all, and those whose
   /// damping was integrated implicitly.
   long clump_steps = 0;

@@ -82,6 +82,11 @@ struct WorldSettings {
   /// below 1/step and a step above 2/rate is refused (as before session 10). In [0, 2].
   double implicit_damping = kImplicitDampingGate;
   double skin = 0.0;  ///< Verlet skin, m; 0 = 0.3 × smallest sphere radius
+  /// Where the displacement bound (the two clumps that moved most could have closed the skin)
+  /// asks for a neighbour rebuild, first search the last rebuild's cells for a touching pair
+  /// the list lacks, and rebuild only if there is one. Off: rebuild at the bound. The
+  /// trajectory is the same bits either way; only the number of rebuilds differs.
+  bool neighbour_search = true;
   /// OpenMP threads; 0 = auto: all cores from 20 000 spheres on, one thread below (see
   /// docs/dem.md). Results are bit-identical for any thread count.
   int threads = 0;
