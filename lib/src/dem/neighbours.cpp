@@ -279,7 +279,7 @@ void World::Impl::rebuild_neighbours() {
   refresh_wall_active();
 }
 
-bool World::Impl::pair_list_complete(double d1) const {
+bool World::Impl::pair_list_complete(double d1) {
   // The last rebuild's bins: (cell key, sphere) of every sphere where it was then, sorted.
   const int ns = static_cast<int>(s_r.size());
   const int nc = static_cast<int>(c_first.size());
@@ -290,14 +290,57 @@ bool World::Impl::pair_list_complete(double d1) const {
       cell < 2.0 * r_max + skin || d1 > skin)
     return false;
   // A pair missing from the list was at least r_i + r_j + skin apart at the rebuild, so it
-  // touches now only if its clumps moved more than the skin together: one of them more than
-  // half. Those clumps' spheres are searched against all.
-  const double half2 = 0.25 * skin * skin;
+  // touches now only if its clumps moved more than the skin together: both more than
+  // skin - d1 (neither moved more than d1), one of them more than half.
+  auto listed = [&](int i, int j) {
+    const PairEntry key{std::min(i, j), std::max(i, j)};
+    const auto at = std::lower_bound(pairs.begin(), pairs.end(), key,
+                                     [](const PairEntry& a, const PairEntry& b) {
+                                       return a.i < b.i || (a.i == b.i && a.j < b.j);
+                                     });
+    return at != pairs.end() && at->i == key.i && at->j == key.j;
+  };
+  auto touching = [&](int i, int j) {
+    const double rr = s_r[i] + s_r[j];
+    return (s_pos[i] - s_pos[j]).squaredNorm() < rr * rr;
+  };
+  // The clumps that moved that far, and among them those that moved more than half the skin.
+  // Past a quarter of the spheres among the latter, a search costs about what a rebuild does.
+  const double lo = std::max(0.0, skin - d1), half2 = 0.25 * skin * skin;
+  std::vector<std::pair<int, double>>& moved = scratch_moved;  // clump, displacement (m)
+  std::vector<int>& fast = scratch_fast;                       // indices into moved
+  moved.clear();
+  fast.clear();
   int fast_spheres = 0;
   for (int c = 0; c < nc; ++c)
-    if (c_disp2[c] > half2) fast_spheres += sphere_end(c) - c_first[c];
-  // Searching costs about what rebuilding does once a quarter of the spheres are searched.
+    if (c_disp2[c] > lo * lo) {
+      if (c_disp2[c] > half2) {
+        fast.push_back(static_cast<int>(moved.size()));
+        fast_spheres += sphere_end(c) - c_first[c];
+      }
+      moved.push_back({c, std::sqrt(c_disp2[c])});
+    }
   if (fast_spheres > ns / 4 + 8) return false;
+  // Usually few clumps moved that far: each fast one's sphere pairs with the others are tested
+  // directly, where their bounding spheres overlap.
+  if (fast.size() * moved.size() <= 4 * static_cast<size_t>(ns)) {
+    for (int fa : fast) {
+      const auto [ca, da] = moved[fa];
+      for (const auto& [cb, db] : moved) {
+        if (cb == ca || da + db <= skin) continue;
+        // Clumps farther apart than their bounding spheres reach cannot touch (with a hair
+        // for rounding).
+        const double reach =
+            (types[c_type[ca]].bound_radius + types[c_type[cb]].bound_radius) * (1.0 + 1e-9);
+        if ((c_x[ca] - c_x[cb]).squaredNorm() >= reach * reach) continue;
+        for (int i = c_first[ca]; i < sphere_end(ca); ++i)
+          for (int j = c_first[cb]; j < sphere_end(cb); ++j)
+            if (touching(i, j) && !listed(i, j)) return false;
+      }
+    }
+    return true;
+  }
+  // Otherwise the fast clumps' spheres are searched against all, in the bins.
   const double h = cell;
   for (int c = 0; c < nc; ++c) {
     if (c_disp2[c] <= half2) continue;
@@ -317,14 +360,7 @@ bool World::Impl::pair_list_complete(double d1) const {
             const int j = it->second;
             const int cj = s_clump[j];
             if (cj == c || dc + std::sqrt(c_disp2[cj]) <= skin) continue;
-            const double rr = s_r[i] + s_r[j];
-            if ((s_pos[i] - s_pos[j]).squaredNorm() >= rr * rr) continue;
-            const PairEntry key{std::min(i, j), std::max(i, j)};
-            const auto at = std::lower_bound(pairs.begin(), pairs.end(), key,
-                                             [](const PairEntry& a, const PairEntry& b) {
-                                               return a.i < b.i || (a.i == b.i && a.j < b.j);
-                                             });
-            if (at == pairs.end() || at->i != key.i || at->j != key.j) return false;
+            if (touching(i, j) && !listed(i, j)) return false;
           }
         }
     }

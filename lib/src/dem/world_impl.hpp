@@ -223,6 +223,8 @@ struct World::Impl {
   std::vector<int> scratch_start, scratch_fill;                  // rebuild_neighbours
   std::vector<std::vector<std::array<int, 2>>> scratch_cand;     // per sphere, rebuild_neighbours
   std::vector<std::pair<std::uint64_t, int>> scratch_bins;       // rebuild_neighbours
+  std::vector<std::pair<int, double>> scratch_moved;             // pair_list_complete
+  std::vector<int> scratch_fast;                                 // pair_list_complete
   std::vector<PerThread<std::pair<int, double>>> scratch_touch;  // per thread: pair, distance
   // Where each thread's block of pair_contacts starts (threads + 1 entries, the last the
   // count), as detect_contacts wrote them; compute_forces evaluates them on the same threads.
@@ -281,7 +283,9 @@ struct World::Impl {
   double kinetic_energy() const;
   double potential_energy() const;
   void rebuild_neighbours();
-  bool pair_list_complete(double d1) const;
+  /// Whether every sphere pair touching now is in the list, where the displacement bound fired
+  /// (d1: the largest clump displacement since the rebuild, m). neighbours.cpp.
+  bool pair_list_complete(double d1);
   void refresh_wall_active();
   std::uint64_t compute_fingerprint() const;
 };

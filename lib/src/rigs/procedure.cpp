@@ -107,6 +107,7 @@ nlohmann::json profile_json(const Ctx& c, const dem::World& w, double sphere_ste
   c.say("engine profile:\n" + pr.table());
   return {{"steps", pr.steps},
           {"neighbour_rebuilds", pr.neighbour_rebuilds},
+          {"neighbour_rebuilds_spared", pr.neighbour_rebuilds_spared},
           {"engine_seconds", pr.total()},
           {"integrate_s", pr.integrate},
           {"walls_s", pr.walls},
