@@ -180,6 +180,9 @@ void World::load_checkpoint(const std::filesystem::path& path) {
   in.vec(w.pairs);
   in.vec(w.pair_hist);
   w.pair_live.clear();  // rebuilt from the histories at the next detection
+  // The bins of the last rebuild are not in the checkpoint: none until the next rebuild (the
+  // search before a rebuild then tests the moved clumps directly or rebuilds).
+  w.scratch_bins.clear();
   in.vec(w.wall_cand_start);
   in.vec(w.wall_cand);
   in.vec(w.wall_slots);

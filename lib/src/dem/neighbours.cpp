@@ -182,11 +182,8 @@ void World::Impl::rebuild_neighbours() {
   std::vector<ContactHistory> next_hist(next.size());
   size_t a = 0;
   for (size_t k = 0; k < next.size(); ++k) {
-    while (a < pairs.size() &&
-           (pairs[a].i < next[k].i || (pairs[a].i == next[k].i && pairs[a].j < next[k].j)))
-      ++a;
-    if (a < pairs.size() && pairs[a].i == next[k].i && pairs[a].j == next[k].j)
-      next_hist[k] = pair_hist[a];
+    while (a < pairs.size() && pairs[a] < next[k]) ++a;
+    if (a < pairs.size() && pairs[a] == next[k]) next_hist[k] = pair_hist[a];
   }
   pairs.swap(next);
   pair_hist.swap(next_hist);
@@ -284,21 +281,17 @@ bool World::Impl::pair_list_complete(double d1) {
   const int ns = static_cast<int>(s_r.size());
   const int nc = static_cast<int>(c_first.size());
   const std::vector<std::pair<std::uint64_t, int>>& bins = scratch_bins;
-  // No bins of the current spheres (a checkpoint was just loaded), or cells too small for the
-  // search below: rebuild.
-  if (static_cast<int>(bins.size()) != ns || static_cast<int>(c_disp2.size()) != nc ||
-      cell < 2.0 * r_max + skin || d1 > skin)
+  // Displacements of other clumps than the current ones, or cells too small for the search
+  // below: rebuild.
+  if (static_cast<int>(c_disp2.size()) != nc || cell < 2.0 * r_max + skin || d1 > skin)
     return false;
   // A pair missing from the list was at least r_i + r_j + skin apart at the rebuild, so it
   // touches now only if its clumps moved more than the skin together: both more than
   // skin - d1 (neither moved more than d1), one of them more than half.
   auto listed = [&](int i, int j) {
     const PairEntry key{std::min(i, j), std::max(i, j)};
-    const auto at = std::lower_bound(pairs.begin(), pairs.end(), key,
-                                     [](const PairEntry& a, const PairEntry& b) {
-                                       return a.i < b.i || (a.i == b.i && a.j < b.j);
-                                     });
-    return at != pairs.end() && at->i == key.i && at->j == key.j;
+    const auto at = std::lower_bound(pairs.begin(), pairs.end(), key);
+    return at != pairs.end() && *at == key;
   };
   auto touching = [&](int i, int j) {
     const double rr = s_r[i] + s_r[j];
@@ -340,7 +333,9 @@ bool World::Impl::pair_list_complete(double d1) {
     }
     return true;
   }
-  // Otherwise the fast clumps' spheres are searched against all, in the bins.
+  // Otherwise the fast clumps' spheres are searched against all, in the bins; without bins of
+  // the current spheres (a checkpoint was loaded since the last rebuild), rebuild.
+  if (static_cast<int>(bins.size()) != ns) return false;
   const double h = cell;
   for (int c = 0; c < nc; ++c) {
     if (c_disp2[c] <= half2) continue;

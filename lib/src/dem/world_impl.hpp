@@ -49,6 +49,14 @@ struct WallData {
 
 struct PairEntry {
   int i = 0, j = 0;  // sphere indices, i < j, different clumps
+  // The list's order: by i, then j (the rebuild sorts it so; the history carry-over and the
+  // search before a rebuild rely on it).
+  friend bool operator<(const PairEntry& a, const PairEntry& b) {
+    return a.i < b.i || (a.i == b.i && a.j < b.j);
+  }
+  friend bool operator==(const PairEntry& a, const PairEntry& b) {
+    return a.i == b.i && a.j == b.j;
+  }
 };
 
 // Geometry of an active sphere-sphere contact (contacts stage) and its result (forces stage).
