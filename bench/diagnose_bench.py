@@ -34,6 +34,7 @@ nothing. Prints the wall time per case. Python 3 standard library only.
   python3 bench/diagnose_bench.py --clumpkit build/apps/clumpkit/clumpkit --out diag_bench \\
       [--scale tiny|mini] [--cases rolling_friction,cohesion] [--jobs 0] [--no-suggest] [--discharge 15]
       [--plates abs_plastic] [--cups ""] [--effects wall_friction,particle_friction]
+      [--truth 0.12]     (the hidden strength, instead of the case's own above)
 """
 import argparse
 import json
@@ -67,20 +68,23 @@ def per_partner(value, partners):
     return [f"{p} = {value}" for p in partners]
 
 
+# case: (truth effects, baseline effects, truth value) for a hidden strength v (None: the
+# case's default, the first number in each lambda's signature).
 CASES = {
-    "rolling_friction": (
-        {"rolling_friction": per_partner(0.2, ["pill"] + WALLS)},
-        {"rolling_friction": per_partner(0.05, ["pill"] + WALLS)}, 0.2),
-    "cohesion": ({"cohesion": ['energy_density = "2e4 J/m^3"']}, {}, 2e4),
-    "wall_friction": ({"wall_friction": per_partner(0.9, WALLS)},
-                      {"wall_friction": per_partner(0.3, WALLS)}, 0.9),
-    "shape_resolution": ({"shape_resolution": ["spheres = 4"]}, {}, 4),
-    "particle_friction": ({"particle_friction": ["value = 0.2"]}, {}, 0.2),
-    "restitution": ({"restitution": per_partner(0.7, ["pill"] + WALLS)}, {}, 0.7),
-    "rolling_model": ({"rolling_model": ['model = "cdt"']}, {}, "cdt"),
-    "size_distribution": ({"size_distribution": ["height_spread = 0.15"]}, {}, 0.15),
-    "none": ({}, {}, None),
-    "rolling_friction+cohesion": (
+    "rolling_friction": lambda v=0.2: (
+        {"rolling_friction": per_partner(v, ["pill"] + WALLS)},
+        {"rolling_friction": per_partner(0.05, ["pill"] + WALLS)}, v),
+    "cohesion": lambda v=2e4: ({"cohesion": [f'energy_density = "{v:g} J/m^3"']}, {}, v),
+    "wall_friction": lambda v=0.9: ({"wall_friction": per_partner(v, WALLS)},
+                                    {"wall_friction": per_partner(0.3, WALLS)}, v),
+    "shape_resolution": lambda v=4: ({"shape_resolution": [f"spheres = {int(v)}"]}, {}, int(v)),
+    "particle_friction": lambda v=0.2: ({"particle_friction": [f"value = {v}"]}, {}, v),
+    "restitution": lambda v=0.7: ({"restitution": per_partner(v, ["pill"] + WALLS)}, {}, v),
+    "rolling_model": lambda v=None: ({"rolling_model": ['model = "cdt"']}, {}, "cdt"),
+    "size_distribution": lambda v=0.15: (
+        {"size_distribution": [f"height_spread = {v}"]}, {}, v),
+    "none": lambda v=None: ({}, {}, None),
+    "rolling_friction+cohesion": lambda v=None: (
         {"rolling_friction": per_partner(0.2, ["pill"] + WALLS),
          "cohesion": ['energy_density = "5000 J/m^3"']},
         {"rolling_friction": per_partner(0.05, ["pill"] + WALLS)}, "0.2 + 5000 J/m^3"),
@@ -110,9 +114,15 @@ def main():
                     help="wheel speeds (rpm, comma-separated) at which the discharger's mass flow "
                          "is measured too (e.g. 15); none by default. Not the pocket mass: "
                          "it is the mass flow times the pocket period, the same measurement")
+    ap.add_argument("--truth", type=float, default=None,
+                    help="the hidden strength of the case(s) (default: each case's own, in the "
+                         "list above); not for rolling_model, none and the pair")
     ap.add_argument("--no-suggest", action="store_true",
                     help="skip the next-measurement suggestion (its trial runs)")
     a = ap.parse_args()
+    fixed = {"rolling_model", "none", "rolling_friction+cohesion"}
+    if a.truth is not None and fixed & set(a.cases.split(",")):
+        ap.error("--truth: the cases " + ", ".join(sorted(fixed)) + " have no strength to set")
     ck, src, out = (os.path.abspath(p) for p in (a.clumpkit, a.source, a.out))
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(src, "shapes", "materials.toml")) as f:
@@ -124,7 +134,8 @@ def main():
     common = ["--scale", a.scale, "--cache", os.path.join(out, "cache"), "--jobs", a.jobs]
     rows = []
     for case in a.cases.split(","):
-        truth_fx, base_fx, truth_value = CASES[case]
+        truth_fx, base_fx, truth_value = (CASES[case]() if a.truth is None
+                                          else CASES[case](a.truth))
         d = os.path.join(out, case)
         os.makedirs(d, exist_ok=True)
         for name, fx in (("truth", truth_fx), ("base", base_fx)):
