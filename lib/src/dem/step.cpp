@@ -829,24 +829,50 @@ void World::Impl::release_pinched(World& world) {
   if (max_overlap_ratio <= settings.pinch_release) return;
   const int nc = static_cast<int>(c_x.size());
   const int ns = static_cast<int>(s_r.size());
+  // Only a moving wall can pinch: a clump is released where it is held against one (it touches
+  // a wall that moves now) and is squeezed by that wall, a fixed wall or another clump. A deep
+  // contact with no moving wall in it is a hard landing (soft pills poured into a heap), left
+  // to the overlap check; releasing those took up to half of a soft mini heap (docs/rigs.md).
+  const int nw = static_cast<int>(walls.size());
+  std::vector<char> moving(nw, 0);
+  bool any_moving = false;
+  for (int k = 0; k < nw; ++k) {
+    const WallPose& p = walls[k].state.pose;
+    moving[k] = p.velocity.squaredNorm() > 0.0 || p.omega.squaredNorm() > 0.0;
+    any_moving = any_moving || moving[k];
+  }
+  if (!any_moving) return;
+  std::vector<char> held(nc, 0);
+  for (int s = 0; s < ns; ++s)
+    for (int k = 0; k < wall_contact_n[s]; ++k)
+      if (moving[wall_contacts_of(s)[k].wall]) held[s_clump[s]] = 1;
   // Both clumps of a pinched pair go: the chain wall → pill → pill → wall is broken either way.
   std::vector<char> out(nc, 0);
   std::string first;
-  double first_ratio = 0.0;
+  double first_ratio = 0.0, kept_ratio = 0.0;
   for (const PairContactData& pc : pair_contacts) {
     const PairEntry& p = pairs[pc.pair];
     const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
     if (ratio <= settings.pinch_release) continue;
+    const int ci = s_clump[p.i], cj = s_clump[p.j];
+    if (!held[ci] && !held[cj]) {
+      kept_ratio = std::max(kept_ratio, ratio);
+      continue;
+    }
     if (ratio > first_ratio) first_ratio = ratio, first = "against another clump";
-    out[s_clump[p.i]] = out[s_clump[p.j]] = 1;
+    out[ci] = out[cj] = 1;
   }
   for (int s = 0; s < ns; ++s)
     for (int k = 0; k < wall_contact_n[s]; ++k) {
-      const double ratio = wall_contacts_of(s)[k].overlap / s_r[s];
+      const WallContactData& wc = wall_contacts_of(s)[k];
+      const double ratio = wc.overlap / s_r[s];
       if (ratio <= settings.pinch_release) continue;
+      if (!moving[wc.wall] && !held[s_clump[s]]) {
+        kept_ratio = std::max(kept_ratio, ratio);
+        continue;
+      }
       if (ratio > first_ratio)
-        first_ratio = ratio,
-        first = "against wall '" + walls[wall_contacts_of(s)[k].wall].name + "'";
+        first_ratio = ratio, first = "against wall '" + walls[wc.wall].name + "'";
       out[s_clump[s]] = 1;
     }
   if (first.empty()) return;
@@ -863,9 +889,9 @@ void World::Impl::release_pinched(World& world) {
   pinched_count += n;
   pinched_mass += m;
   world.remove_clumps([&](int c) { return out[c] != 0; });
-  // Every contact deeper than the release (< 0.5) went with its clumps: nothing left for the
-  // overlap check of this step.
-  max_overlap_ratio = 0.0;
+  // The deepest contact left (no moving wall in it, or a clump not taken out) stays for this
+  // step's overlap check (an overestimate where its clump went with a released pair).
+  max_overlap_ratio = kept_ratio;
 }
 
 void World::Impl::check_health() {

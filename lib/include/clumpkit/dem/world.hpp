@@ -98,9 +98,12 @@ struct WorldSettings {
   /// Pinch release, a fraction of a sphere radius in [0, 0.5); 0 = off. A prescribed wall
   /// has unlimited force: a pill caught between a moving wall and a fixed one (a vane tip
   /// passing the throat edge, a scraper at the rim) is squeezed without limit, and the run
-  /// would stop at the 50 % overlap check. With a release set, a clump whose overlap with a
-  /// wall exceeds it is taken out of the run instead (a real pill would break or be pushed
-  /// aside) and counted by World::pinched_count() / pinched_mass(); the first one is a warning.
+  /// would stop at the 50 % overlap check. With a release set, a clump held against a wall
+  /// that moves now (it touches one) whose overlap with a wall or another clump exceeds it is
+  /// taken out of the run instead (a real pill would break or be pushed aside), with the clump
+  /// it is squeezed against, and counted by World::pinched_count() / pinched_mass(); the first
+  /// one is a warning. A deep contact with no moving wall in it (a hard landing) is not
+  /// released: the overlap check judges it.
   double pinch_release = 0.0;
 };
 
