@@ -48,8 +48,9 @@ inline constexpr double kImplicitDampingGate = 0.5;
 inline constexpr double kTangentialGate = 1.6;
 
 /// Changes whenever the engine gives different results for the same input (caches of rig
-/// results key on it): 2 = session 10's implicit damping and the time step it allows.
-inline constexpr int kPhysicsRevision = 2;
+/// results key on it): 2 = session 10's implicit damping and the time step it allows; 3 =
+/// session 50's pinch release, which takes only clumps held against a moving wall.
+inline constexpr int kPhysicsRevision = 3;
 
 struct WorldSettings {
   /// Where the settings came from (scene file), used in InputError messages.
