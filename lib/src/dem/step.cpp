@@ -849,16 +849,13 @@ void World::Impl::release_pinched(World& world) {
   // Both clumps of a pinched pair go: the chain wall → pill → pill → wall is broken either way.
   std::vector<char> out(nc, 0);
   std::string first;
-  double first_ratio = 0.0, kept_ratio = 0.0;
+  double first_ratio = 0.0;
   for (const PairContactData& pc : pair_contacts) {
     const PairEntry& p = pairs[pc.pair];
     const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
     if (ratio <= settings.pinch_release) continue;
     const int ci = s_clump[p.i], cj = s_clump[p.j];
-    if (!held[ci] && !held[cj]) {
-      kept_ratio = std::max(kept_ratio, ratio);
-      continue;
-    }
+    if (!held[ci] && !held[cj]) continue;
     if (ratio > first_ratio) first_ratio = ratio, first = "against another clump";
     out[ci] = out[cj] = 1;
   }
@@ -867,15 +864,31 @@ void World::Impl::release_pinched(World& world) {
       const WallContactData& wc = wall_contacts_of(s)[k];
       const double ratio = wc.overlap / s_r[s];
       if (ratio <= settings.pinch_release) continue;
-      if (!moving[wc.wall] && !held[s_clump[s]]) {
-        kept_ratio = std::max(kept_ratio, ratio);
-        continue;
-      }
+      if (!moving[wc.wall] && !held[s_clump[s]]) continue;
       if (ratio > first_ratio)
         first_ratio = ratio, first = "against wall '" + walls[wc.wall].name + "'";
       out[s_clump[s]] = 1;
     }
   if (first.empty()) return;
+  // The deepest contact that stays (both its clumps stay) is this step's overlap check's (the
+  // clumps named by their indices before the removal, as the detection named them).
+  double kept = 0.0;
+  std::string kept_what;
+  for (const PairContactData& pc : pair_contacts) {
+    const PairEntry& p = pairs[pc.pair];
+    const int ci = s_clump[p.i], cj = s_clump[p.j];
+    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
+    if (!out[ci] && !out[cj] && ratio > kept)
+      kept = ratio, kept_what = "clumps " + std::to_string(ci) + " and " + std::to_string(cj);
+  }
+  for (int s = 0; s < ns; ++s)
+    for (int k = 0; k < wall_contact_n[s]; ++k) {
+      const WallContactData& wc = wall_contacts_of(s)[k];
+      const double ratio = wc.overlap / s_r[s];
+      if (!out[s_clump[s]] && ratio > kept)
+        kept = ratio, kept_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
+                                  walls[wc.wall].name + "'";
+    }
   int n = 0;
   double m = 0.0;
   for (int c = 0; c < nc; ++c)
@@ -889,9 +902,8 @@ void World::Impl::release_pinched(World& world) {
   pinched_count += n;
   pinched_mass += m;
   world.remove_clumps([&](int c) { return out[c] != 0; });
-  // The deepest contact left (no moving wall in it, or a clump not taken out) stays for this
-  // step's overlap check (an overestimate where its clump went with a released pair).
-  max_overlap_ratio = kept_ratio;
+  max_overlap_ratio = kept;
+  max_overlap_what = kept_what;
 }
 
 void World::Impl::check_health() {
