@@ -330,6 +330,37 @@ TEST(Walls, PinchReleaseLeavesAHardImpactWithoutAMovingWall) {
   EXPECT_GT(w.velocities()[1].x(), 0.0);
 }
 
+// A moving wall pinches through the clumps it presses on. A column between the floor and the
+// descending ceiling: ball A (r = 2 mm) under the ceiling, ball B (2 mm) under it, a small
+// ball C (1 mm) on the floor. The same force runs down the column, and a Hertz overlap goes as
+// R*^(-1/3): in units of the smaller radius, B-C passes 25 % first (A-B is then at ~11 %), far
+// from the ceiling; neither B nor C touches a moving wall. B and C are loaded by the ceiling
+// through A, so they are released; A stays. (Releasing only clumps that touch the moving wall,
+// session 50's rule, left B-C to reach the 50 % overlap check: the run stopped.)
+TEST(Walls, PinchReleaseTakesADeepContactTheMovingWallLoadsThroughAnotherClump) {
+  WorldSettings s = squeeze(0.25);
+  s.clump_types.push_back(test::sphere_type("small", 1e-3, 1380.0));
+  s.walls[1].mesh =
+      make_plane(Eigen::Vector3d(0, 0, 10.1e-3), -Eigen::Vector3d::UnitZ(), 0.04, 0.04);
+  World w = World::create(s);
+  w.add_clump(0, Eigen::Vector3d(0, 0, 8e-3));  // A
+  w.add_clump(0, Eigen::Vector3d(0, 0, 4e-3));  // B
+  w.add_clump(1, Eigen::Vector3d(0, 0, 1e-3));  // C
+  const double m = w.clump_mass(0) + w.clump_mass(2);
+  // B-C passes 25 % of 1 mm when the ceiling has closed ~0.96 mm (t ~ 0.019 s) and would pass
+  // 50 % at ~0.036 s.
+  w.run_until(0.012);
+  EXPECT_EQ(w.pinched_count(), 0);
+  ASSERT_NO_THROW(w.run_until(0.03));
+  EXPECT_EQ(w.pinched_count(), 2);
+  EXPECT_NEAR(w.pinched_mass(), m, 1e-12 * m);
+  EXPECT_EQ(w.clump_count(), 1);  // a ball and the small one went: B and C (A never touches C)
+  bool warned = false;
+  for (const auto& msg : w.warnings())
+    warned = warned || msg.find("pinched against another clump") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 TEST(Walls, PinchReleaseOutOfRangeIsAnInputError) {
   WorldSettings s = squeeze(0.5);
   EXPECT_THROW((void)World::create(s), InputError);

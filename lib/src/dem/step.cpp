@@ -829,10 +829,14 @@ void World::Impl::release_pinched(World& world) {
   if (max_overlap_ratio <= settings.pinch_release) return;
   const int nc = static_cast<int>(c_x.size());
   const int ns = static_cast<int>(s_r.size());
-  // Only a moving wall can pinch: a clump is released where it is held against one (it touches
-  // a wall that moves now) and is squeezed by that wall, a fixed wall or another clump. A deep
-  // contact with no moving wall in it is a hard landing (soft pills poured into a heap), left
-  // to the overlap check; releasing those took up to half of a soft mini heap (docs/rigs.md).
+  // Only a moving wall can pinch, and it pinches through the pills it presses on: a clump is
+  // released where it is loaded by a wall that moves now (it touches one, or touches a clump
+  // that is loaded: a settled bed under a scraper is one chain) and is squeezed by a wall or
+  // another clump. A deep contact among clumps that no moving wall loads is a hard landing
+  // (soft pills poured into a heap while every wall rests), left to the overlap check;
+  // releasing those took up to half of a soft mini heap (docs/rigs.md). Releasing only the
+  // clumps that touch the moving wall themselves (session 50) left a pill wedged by the one the
+  // scraper pushes against the cup's rim, and two of nine Table-1 cups at mini blew up.
   const int nw = static_cast<int>(walls.size());
   std::vector<char> moving(nw, 0);
   bool any_moving = false;
@@ -842,10 +846,25 @@ void World::Impl::release_pinched(World& world) {
     any_moving = any_moving || moving[k];
   }
   if (!any_moving) return;
-  std::vector<char> held(nc, 0);
+  // The clumps a moving wall loads: the groups of touching clumps (union-find over this step's
+  // pair contacts) that hold a clump touching such a wall.
+  std::vector<int> group(nc);
+  for (int c = 0; c < nc; ++c) group[c] = c;
+  auto root = [&](int c) {
+    while (group[c] != c) c = group[c] = group[group[c]];
+    return c;
+  };
+  for (const PairContactData& pc : pair_contacts) {
+    const PairEntry& p = pairs[pc.pair];
+    const int a = root(s_clump[p.i]), b = root(s_clump[p.j]);
+    if (a != b) group[std::max(a, b)] = std::min(a, b);
+  }
+  std::vector<char> group_held(nc, 0);
   for (int s = 0; s < ns; ++s)
     for (int k = 0; k < wall_contact_n[s]; ++k)
-      if (moving[wall_contacts_of(s)[k].wall]) held[s_clump[s]] = 1;
+      if (moving[wall_contacts_of(s)[k].wall]) group_held[root(s_clump[s])] = 1;
+  std::vector<char> held(nc, 0);
+  for (int c = 0; c < nc; ++c) held[c] = group_held[root(c)];
   // Both clumps of a pinched pair go: the chain wall → pill → pill → wall is broken either way.
   std::vector<char> out(nc, 0);
   std::string first;

@@ -49,8 +49,9 @@ inline constexpr double kTangentialGate = 1.6;
 
 /// Changes whenever the engine gives different results for the same input (caches of rig
 /// results key on it): 2 = session 10's implicit damping and the time step it allows; 3 =
-/// session 50's pinch release, which takes only clumps held against a moving wall.
-inline constexpr int kPhysicsRevision = 3;
+/// session 50's pinch release, which takes only clumps held against a moving wall; 4 = session
+/// 51's, which takes the clumps a moving wall loads through the clumps they touch.
+inline constexpr int kPhysicsRevision = 4;
 
 struct WorldSettings {
   /// Where the settings came from (scene file), used in InputError messages.
@@ -99,12 +100,13 @@ struct WorldSettings {
   /// Pinch release, a fraction of a sphere radius in [0, 0.5); 0 = off. A prescribed wall
   /// has unlimited force: a pill caught between a moving wall and a fixed one (a vane tip
   /// passing the throat edge, a scraper at the rim) is squeezed without limit, and the run
-  /// would stop at the 50 % overlap check. With a release set, a clump held against a wall
-  /// that moves now (it touches one) whose overlap with a wall or another clump exceeds it is
-  /// taken out of the run instead (a real pill would break or be pushed aside), with the clump
-  /// it is squeezed against, and counted by World::pinched_count() / pinched_mass(); the first
-  /// one is a warning. A deep contact with no moving wall in it (a hard landing) is not
-  /// released: the overlap check judges it.
+  /// would stop at the 50 % overlap check. With a release set, a clump loaded by a wall that
+  /// moves now (it touches one, or touches a clump so loaded) whose overlap with a wall or
+  /// another clump exceeds it is taken out of the run instead (a real pill would break or be
+  /// pushed aside), with the clump it is squeezed against, and counted by
+  /// World::pinched_count() / pinched_mass(); the first one is a warning. A deep contact among
+  /// clumps no moving wall loads (a hard landing while the walls rest) is not released: the
+  /// overlap check judges it.
   double pinch_release = 0.0;
 };
 
