@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <string>
 
 #include "clumpkit/core/error.hpp"
 #include "dem/implicit_solve.hpp"
@@ -71,6 +72,14 @@ inline Eigen::Vector2d dashpot_load(const ContactForce& f, const TypeData& t,
   const double inv_i = t.inv_inertia.maxCoeff();
   return {f.dashpot_n * (t.inv_mass + r.cross(n).squaredNorm() * inv_i),
           f.dashpot_t * (t.inv_mass + r.squaredNorm() * inv_i)};
+}
+
+// How the overlap check names a contact: two clumps, or a clump and a wall.
+std::string clumps_what(int ci, int cj) {
+  return "clumps " + std::to_string(ci) + " and " + std::to_string(cj);
+}
+std::string wall_what(int c, const std::string& wall) {
+  return "clump " + std::to_string(c) + " and wall '" + wall + "'";
 }
 
 }  // namespace
@@ -387,8 +396,7 @@ void World::Impl::detect_contacts() {
     if (scratch_max[t].first > max_overlap_ratio) {
       max_overlap_ratio = scratch_max[t].first;
       const PairEntry& p = pairs[scratch_max[t].second];
-      max_overlap_what =
-          "clumps " + std::to_string(s_clump[p.i]) + " and " + std::to_string(s_clump[p.j]);
+      max_overlap_what = clumps_what(s_clump[p.i], s_clump[p.j]);
     }
 
   // Sphere-wall contacts, one sphere at a time. Candidates closer than the radius are sorted
@@ -519,12 +527,10 @@ void World::Impl::detect_contacts() {
     const int s = wall_active[a];
     if (ratio_s[a] > max_overlap_ratio) {
       max_overlap_ratio = ratio_s[a];
-      max_overlap_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
-                         walls[wall_contacts[a][0].wall].name + "'";
+      max_overlap_what = wall_what(s_clump[s], walls[wall_contacts[a][0].wall].name);
       for (int k = 0; k < wall_contact_n[s]; ++k)
         if (wall_contacts[a][k].overlap / s_r[s] >= ratio_s[a])
-          max_overlap_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
-                             walls[wall_contacts[a][k].wall].name + "'";
+          max_overlap_what = wall_what(s_clump[s], walls[wall_contacts[a][k].wall].name);
     }
     if (overflow[a] && !slot_overflow_warned) {
       slot_overflow_warned = true;
@@ -865,13 +871,17 @@ void World::Impl::release_pinched(World& world) {
       if (moving[wall_contacts_of(s)[k].wall]) group_held[root(s_clump[s])] = 1;
   std::vector<char> held(nc, 0);
   for (int c = 0; c < nc; ++c) held[c] = group_held[root(c)];
+  auto pair_ratio = [&](const PairContactData& pc) {
+    const PairEntry& p = pairs[pc.pair];
+    return pc.overlap / std::min(s_r[p.i], s_r[p.j]);
+  };
   // Both clumps of a pinched pair go: the chain wall → pill → pill → wall is broken either way.
   std::vector<char> out(nc, 0);
   std::string first;
   double first_ratio = 0.0;
   for (const PairContactData& pc : pair_contacts) {
     const PairEntry& p = pairs[pc.pair];
-    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
+    const double ratio = pair_ratio(pc);
     if (ratio <= settings.pinch_release) continue;
     const int ci = s_clump[p.i], cj = s_clump[p.j];
     if (!held[ci] && !held[cj]) continue;
@@ -896,17 +906,15 @@ void World::Impl::release_pinched(World& world) {
   for (const PairContactData& pc : pair_contacts) {
     const PairEntry& p = pairs[pc.pair];
     const int ci = s_clump[p.i], cj = s_clump[p.j];
-    const double ratio = pc.overlap / std::min(s_r[p.i], s_r[p.j]);
-    if (!out[ci] && !out[cj] && ratio > kept)
-      kept = ratio, kept_what = "clumps " + std::to_string(ci) + " and " + std::to_string(cj);
+    const double ratio = pair_ratio(pc);
+    if (!out[ci] && !out[cj] && ratio > kept) kept = ratio, kept_what = clumps_what(ci, cj);
   }
   for (int s = 0; s < ns; ++s)
     for (int k = 0; k < wall_contact_n[s]; ++k) {
       const WallContactData& wc = wall_contacts_of(s)[k];
       const double ratio = wc.overlap / s_r[s];
       if (!out[s_clump[s]] && ratio > kept)
-        kept = ratio, kept_what = "clump " + std::to_string(s_clump[s]) + " and wall '" +
-                                  walls[wc.wall].name + "'";
+        kept = ratio, kept_what = wall_what(s_clump[s], walls[wc.wall].name);
     }
   int n = 0;
   double m = 0.0;
